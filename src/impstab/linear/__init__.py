@@ -1,0 +1,11 @@
+"""Linear stability: linearization, eigenproblems, mode tracking, loci, critical loads, modal form."""
+
+from .critical import CriticalLoad, Crossing, critical_load, critical_load_family
+from .families import CallableFamily, LinearFamily
+from .linearize import ModelFamily, linearize
+from .system import LinearSystem
+
+__all__ = [
+    "LinearSystem", "linearize", "ModelFamily", "LinearFamily", "CallableFamily",
+    "critical_load", "critical_load_family", "CriticalLoad", "Crossing",
+]

@@ -1,0 +1,483 @@
+"""Critical load of ``M q'' + (D + G) q' + K(p) q = 0``: the first loss of stability from p = 0.
+
+Method (THEORY 5)
+-----------------
+1. Scan ``p`` on a uniform grid in batches (stacks of eigenproblems), stopping at the first
+   unstable point. Between stable grid points, wherever the closest pair of frequencies has a
+   local minimum (undamped) or the growth rate a local maximum (damped), the closest approach is
+   located by bounded minimisation and tested, so that narrow flutter bubbles are not stepped over.
+2. Refine the bracket with an *exact*, smooth indicator that crosses zero linearly, solved by
+   Brent's method to machine precision:
+
+   * undamped, non-gyroscopic: eigenvalues ``s = omega^2`` of ``M^-1 K``. The merging cluster
+     (two eigenvalues, or four for symmetric layouts where two planes merge at once) is followed
+     by its invariant subspace, and ``Delta(p) = k sum s_i^2 - (sum s_i)^2`` over the cluster is a
+     symmetric function of the cluster: analytic in ``p`` although the double root is defective
+     (its individual eigenvalues carry sqrt(eps) noise, ``Delta`` only eps). ``Delta > 0`` while
+     the cluster is real, ``< 0`` once it is a complex pair. Divergence: the cluster mean of the
+     real ``s`` crossing zero.
+   * damped or gyroscopic: the largest real part of the eigenvalues of the state matrix in the
+     cluster that goes unstable (a Hopf crossing, smooth). Where that branch was marginal before
+     (undamped gyroscopic systems), the onset is where it leaves the axis by the classification
+     tolerance; the branch leaves like ``sqrt(p - p_c)``, so the error is of order tolerance squared.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import optimize
+
+from .eigen import kinetic_shares, state_matrices
+from .families import LinearFamily, SystemFamily
+
+__all__ = ["CriticalLoad", "Crossing", "critical_load", "critical_load_family"]
+
+Array = NDArray[np.float64]
+
+#: relative size of an imaginary part (of s) or a real part (of lambda) that counts as unstable
+TOL_UNSTABLE = 1e-7
+#: real part (relative) above which a branch counts as marginal (on the axis to rounding)
+TOL_MARGINAL = 1e-11
+#: relative distance within which eigenvalues belong to one cluster
+TOL_CLUSTER = 1e-6
+#: relative gap below which two real s are symmetric duplicates, not an approach
+TOL_DUPLICATE = 1e-9
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """A change of stability at load ``load``: ``"loss"`` (stable -> unstable) or ``"gain"``."""
+
+    load: float
+    direction: str
+    kind: str
+    omega: float
+
+
+@dataclass(frozen=True, eq=False)
+class CriticalLoad:
+    """Result of a critical-load search.
+
+    Attributes
+    ----------
+    load : float or None
+        Critical load ``p_c`` (first loss of stability from p = 0), None when stable up to ``p_max``.
+    kind : {"flutter", "divergence", "none"}
+    omega : float or None
+        Angular frequency at onset (rad/s); 0 for divergence.
+    frequency_hz : float or None
+        ``omega / 2 pi`` (Hz).
+    mode : (n,) complex array or None
+        Displacement shape of the critical mode at onset.
+    participation : (n,) array or None
+        Kinetic-energy share of each dof in the critical cluster's subspace.
+    p_max : float
+        Upper end of the search.
+    method : str
+        ``"coalescence"`` (undamped discriminant) or ``"hopf"`` (state-matrix real part).
+    crossings : tuple of Crossing
+        Every stability change up to ``p_max`` (only when requested with ``all_crossings``).
+    evaluations : int
+        Number of eigenproblems solved.
+    """
+
+    load: float | None
+    kind: str
+    omega: float | None
+    p_max: float
+    method: str
+    mode: Array | None = None
+    participation: Array | None = None
+    crossings: tuple[Crossing, ...] = field(default_factory=tuple)
+    evaluations: int = 0
+
+    @property
+    def frequency_hz(self) -> float | None:
+        return None if self.omega is None else self.omega / (2.0 * np.pi)
+
+
+class _Unstable(Exception):
+    def __init__(self, p: float) -> None:
+        self.p = p
+
+
+class _Engine:
+    def __init__(self, family: SystemFamily, p_max: float, undamped: bool | None = None) -> None:
+        self.family = family
+        self.n = family.n
+        self.evaluations = 0
+        # damping and gyroscopic terms may depend on the load (a propeller speed that follows it)
+        _, d, g, _ = family.matrices(np.array([0.0, 0.5 * p_max, p_max]))
+        self.damped = bool(np.any(d != 0))
+        if undamped is None:
+            undamped = not (self.damped or np.any(g != 0))
+        self.undamped = undamped
+        # affine families (constant M, D, G; K = K0 + p K1): the operator is op0 + p op1
+        parts = family.affine_parts() if hasattr(family, "affine_parts") else None
+        self.ops = None
+        if parts is not None:
+            m, d, g, k0, k1 = parts
+            self.mass = np.array(m)
+            if undamped:
+                a0 = np.linalg.solve(m, k0)
+                a1 = np.linalg.solve(m, k1)
+            else:
+                a0 = state_matrices(m, d + g, k0)
+                a1 = np.zeros_like(a0)
+                a1[self.n:, : self.n] = -np.linalg.solve(m, k1)
+            self.ops = (a0, a1)
+
+    def operators(self, p: Array) -> tuple[Array, Array]:
+        """The eigen-operator (``M^-1 K`` or the state matrix) at each load, and the mass."""
+        if self.ops is not None:
+            a0, a1 = self.ops
+            return a0[None] + p[:, None, None] * a1[None], np.broadcast_to(self.mass, (len(p),) + self.mass.shape)
+        m, d, g, k = self.family.matrices(p)
+        if self.undamped:
+            return np.linalg.solve(m, k), m
+        return state_matrices(m, d + g, k), m
+
+    # -- batched classification of grid points --------------------------------------------
+    def classify(self, p: Array) -> tuple[Array, Array]:
+        """Stability flags and the bubble indicator (closest gap / growth) at each load."""
+        ops, _ = self.operators(p)
+        self.evaluations += len(p)
+        if self.undamped:
+            s = np.linalg.eigvals(ops)
+            scale = np.abs(s).max(axis=-1)
+            im = np.abs(s.imag) / scale[:, None]
+            re = s.real / scale[:, None]
+            cplx = im > TOL_UNSTABLE
+            unstable = cplx.any(axis=-1) | ((re < 0) & ~cplx).any(axis=-1)
+            srt = np.sort(re, axis=-1)
+            diffs = np.diff(srt, axis=-1)
+            diffs[diffs < TOL_DUPLICATE] = np.inf
+            gap = diffs.min(axis=-1) if diffs.shape[-1] else np.full(len(p), np.inf)
+            indicator = np.where(cplx.any(axis=-1), -im.max(axis=-1), gap)
+            return unstable, indicator
+        lam = np.linalg.eigvals(ops)
+        scale = np.abs(lam).max(axis=-1)
+        growth = lam.real.max(axis=-1) / scale
+        return growth > TOL_UNSTABLE, -growth
+
+    def unstable_at(self, p: float) -> bool:
+        return bool(self.classify(np.array([p]))[0][0])
+
+    # -- eigen-decomposition at one load ------------------------------------------------------
+    def decompose(self, p: float):
+        ops, m = self.operators(np.array([p]))
+        self.evaluations += 1
+        vals, vecs = np.linalg.eig(ops[0])
+        return vals, vecs, m[0]
+
+    def unstable_cluster(self, vals: Array) -> tuple[Array, bool, bool]:
+        """Indices of the cluster that is unstable, whether it is unique, and if divergent."""
+        scale = np.abs(vals).max()
+        if self.undamped:
+            cplx = np.abs(vals.imag) > TOL_UNSTABLE * scale
+            neg = (vals.real < 0) & ~cplx
+            bad = np.flatnonzero(cplx | neg)
+            if cplx.any():
+                j0 = np.flatnonzero(cplx)[np.argmin(vals.real[cplx])]
+                divergence = False
+            else:
+                j0 = bad[np.argmin(vals.real[bad])]
+                divergence = True
+        else:
+            bad = np.flatnonzero(vals.real > TOL_UNSTABLE * scale)
+            j0 = bad[np.argmax(vals.real[bad])]
+            divergence = abs(vals[j0].imag) <= TOL_CLUSTER * scale
+        ref = vals[j0]
+        close = (np.abs(vals - ref) <= TOL_CLUSTER * scale) | (
+            np.abs(vals - np.conj(ref)) <= TOL_CLUSTER * scale
+        )
+        members = np.flatnonzero(close)
+        unique = set(bad.tolist()) <= set(members.tolist())
+        return members, unique, divergence
+
+    @staticmethod
+    def projector(vecs: Array, members: Array) -> tuple[Array, Array]:
+        """Spectral projector onto the cluster's invariant subspace, as ``(V_C, W_C^H)``.
+
+        The projector is oblique (``V_C W_C^H`` with left eigenvectors ``W^H = V^-1``): for a
+        non-normal problem the right eigenvectors of other clusters are not orthogonal to it.
+        """
+        inv = np.linalg.inv(vecs)
+        return vecs[:, members], inv[members, :]
+
+    @staticmethod
+    def select(vecs: Array, proj: tuple[Array, Array], k: int) -> tuple[Array, bool]:
+        """The ``k`` eigenvectors lying most in the cluster subspace, and whether that is clear."""
+        v_c, w_c = proj
+        norms = np.linalg.norm(vecs, axis=0)
+        share = np.linalg.norm(v_c @ (w_c @ vecs), axis=0) / norms
+        order = np.argsort(-share)
+        sel = order[:k]
+        ok = share[sel[-1]] > 0.5 and (len(order) == k or share[order[k]] < 0.5)
+        return sel, ok
+
+    # -- refinement of one bracket -----------------------------------------------------------
+    def refine(self, a: float, b: float) -> tuple[float, str, float, Array, Array]:
+        """Root of the exact indicator between stable ``a`` and unstable ``b``."""
+        for _ in range(200):
+            vals_b, vecs_b, _ = self.decompose(b)
+            members, unique, divergence = self.unstable_cluster(vals_b)
+            basis = self.projector(vecs_b, members)
+            k = len(members)
+            vals_a, vecs_a, _ = self.decompose(a)
+            _, ok_a = self.select(vecs_a, basis, k)
+            if unique and ok_a:
+                try:
+                    return self._solve(a, b, basis, k, divergence)
+                except _Ambiguous:
+                    pass
+            mid = 0.5 * (a + b)
+            if mid in (a, b):
+                break
+            if self.unstable_at(mid):
+                b = mid
+            else:
+                a = mid
+        # the bracket is as narrow as floating point allows
+        vals, vecs, m = self.decompose(b)
+        members, _, divergence = self.unstable_cluster(vals)
+        return self._finish(b, vals, vecs, m, members, divergence)
+
+    def _indicator(self, basis: Array, k: int, divergence: bool, target: float):
+        def fun(p: float) -> float:
+            vals, vecs, _ = self.decompose(p)
+            sel, ok = self.select(vecs, basis, k)
+            if not ok:
+                raise _Ambiguous
+            v = vals[sel]
+            scale = np.abs(vals).max()
+            if self.undamped:
+                if divergence:
+                    return float(v.real.mean() / scale)
+                z = v / scale
+                return float((k * np.sum(z * z) - np.sum(z) ** 2).real)
+            return float(v.real.max() / scale) - target
+
+        return fun
+
+    def _solve(self, a: float, b: float, basis: Array, k: int, divergence: bool):
+        target = 0.0
+        if not self.undamped:
+            fa = self._indicator(basis, k, divergence, 0.0)(a)
+            if not self.damped or fa > -TOL_MARGINAL:
+                # the branch was marginal (on the imaginary axis to rounding) before it left it
+                target = TOL_UNSTABLE
+        fun = self._indicator(basis, k, divergence, target)
+        fa, fb = fun(a), fun(b)
+        if fa == 0.0:
+            root = a
+        elif np.sign(fa) == np.sign(fb):
+            raise _Ambiguous
+        else:
+            root = optimize.brentq(fun, a, b, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=200)
+        vals, vecs, m = self.decompose(root)
+        sel, _ = self.select(vecs, basis, k)
+        return self._finish(root, vals, vecs, m, sel, divergence, basis, a)
+
+    def _finish(self, p, vals, vecs, m, members, divergence, proj=None, before=None):
+        """Onset values at ``p``; participation from the distinct modes at ``before`` (stable side)."""
+        n = self.n
+        v = vals[members]
+        if self.undamped:
+            omega = 0.0 if divergence else float(np.sqrt(max(v.real.mean(), 0.0)))
+            lead = members[np.argmax(np.abs(v.imag))] if not divergence else members[0]
+            mode = vecs[:, lead]
+        else:
+            j = members[np.argmax(v.real)]
+            omega = 0.0 if divergence else float(abs(vals[j].imag))
+            mode = vecs[:n, j]
+        shapes = vecs[:n, members]
+        if proj is not None and before is not None:
+            vals_b, vecs_b, _ = self.decompose(before)
+            sel, ok = self.select(vecs_b, proj, len(members))
+            if ok:
+                shapes = vecs_b[:n, sel]
+        # each mode of the cluster weighs equally in the participation
+        part = np.mean([kinetic_shares(shapes[:, [j]], m) for j in range(shapes.shape[1])], axis=0)
+        kind = "divergence" if divergence else "flutter"
+        big = np.argmax(np.abs(mode))
+        mode = mode * np.conj(mode[big]) / np.abs(mode[big]) ** 2
+        return float(p), kind, omega, mode, part
+
+    # -- scan ---------------------------------------------------------------------------------
+    def attracting(self, lo: float, mid: float, hi: float) -> bool:
+        """Whether the closest pair of real ``s`` at ``mid`` can merge (undamped only).
+
+        Two nearby eigenvalues interact, to first order in the load, through the off-diagonal
+        entries ``B_lu``, ``B_ul`` of ``dA/dp`` in the biorthogonal eigenbasis (``A = M^-1 K``).
+        A product ``B_lu B_ul < 0`` pulls them together (they may merge: a possible bubble);
+        ``> 0`` makes them veer apart; zero (to rounding) means they do not interact, as for modes
+        decoupled by symmetry, which simply cross.
+        """
+        if not self.undamped:
+            return True
+        a, _ = self.operators(np.array([lo, mid, hi]))
+        self.evaluations += 3
+        vals, vecs = np.linalg.eig(a[1])
+        if np.abs(vals.imag).max() > TOL_UNSTABLE * np.abs(vals).max():
+            return True
+        order = np.argsort(vals.real)
+        re = vals.real[order]
+        scale = np.abs(re).max()
+        diffs = np.diff(re)
+        distinct = np.flatnonzero(diffs >= TOL_DUPLICATE * scale)
+        if distinct.size == 0:
+            return False
+        j = distinct[np.argmin(diffs[distinct])]
+        lower = order[np.abs(re - re[j]) < TOL_DUPLICATE * scale]
+        upper = order[np.abs(re - re[j + 1]) < TOL_DUPLICATE * scale]
+        rate = (a[2] - a[0]) / (hi - lo)
+        b = np.linalg.solve(vecs, rate @ vecs)
+        inter = np.linalg.eigvals(b[np.ix_(lower, upper)] @ b[np.ix_(upper, lower)])
+        norm = max(np.abs(rate).max(), 1e-300)
+        return bool(np.any(inter.real < -1e-8 * norm**2))
+
+    def bubble(self, lo: float, hi: float) -> float | None:
+        """Closest approach in ``(lo, hi)``; the load of an instability found there, else None."""
+
+        def fun(p: float) -> float:
+            unstable, ind = self.classify(np.array([p]))
+            if unstable[0]:
+                raise _Unstable(p)
+            return float(ind[0])
+
+        try:
+            optimize.minimize_scalar(
+                fun, bounds=(lo, hi), method="bounded", options={"xatol": (hi - lo) * 1e-9}
+            )
+        except _Unstable as hit:
+            return hit.p
+        return None
+
+    def scan(self, p_min: float, p_max: float, n_scan: int, chunk: int, all_crossings: bool):
+        grid = np.linspace(p_min, p_max, n_scan + 1)
+        flags = np.zeros(0, dtype=bool)
+        ind = np.zeros(0)
+        brackets: list[tuple[float, float]] = []
+        checked = 0  # grid index up to which bubbles were examined
+        start = 0
+        while start < len(grid):
+            stop = min(start + chunk, len(grid))
+            f, i = self.classify(grid[start:stop])
+            flags = np.concatenate([flags, f])
+            ind = np.concatenate([ind, i])
+            # examine transitions and bubbles up to the last point with both neighbours known
+            limit = len(flags) - 1 if stop < len(grid) else len(flags)
+            for j in range(max(checked, 1), limit):
+                if flags[j] != flags[j - 1]:
+                    lo, hi = (grid[j - 1], grid[j])
+                    brackets.append((lo, hi) if not flags[j - 1] else (hi, lo))
+                elif (
+                    not flags[j]
+                    and j + 1 < len(flags)
+                    and not flags[j + 1]
+                    and ind[j] < ind[j - 1]
+                    and ind[j] <= ind[j + 1]
+                    and self.attracting(grid[j - 1], grid[j], grid[j + 1])
+                ):
+                    hit = self.bubble(grid[j - 1], grid[j + 1])
+                    if hit is not None:
+                        # stable at grid[j-1]; unstable at hit; stable again by grid[j+1]
+                        brackets.append((grid[j - 1], hit))
+                        if all_crossings:
+                            brackets.append((grid[j + 1], hit))
+                if brackets and not all_crossings:
+                    return grid, flags, brackets
+            checked = limit
+            start = stop
+        return grid, flags, brackets
+
+
+class _Ambiguous(Exception):
+    pass
+
+
+def critical_load_family(
+    family: SystemFamily,
+    p_max: float,
+    *,
+    p_min: float = 0.0,
+    n_scan: int = 64,
+    chunk: int = 32,
+    all_crossings: bool = False,
+    undamped: bool | None = None,
+) -> CriticalLoad:
+    """Critical load of a family ``p -> (M, D, G, K)`` (see :func:`critical_load`)."""
+    if not (np.isfinite(p_max) and p_max > p_min):
+        raise ValueError(f"p_max = {p_max!r}: must be finite and above p_min = {p_min!r}")
+    eng = _Engine(family, p_max, undamped=undamped)
+    method = "coalescence" if eng.undamped else "hopf"
+    if eng.unstable_at(p_min):
+        vals, vecs, m = eng.decompose(p_min)
+        members, _, divergence = eng.unstable_cluster(vals)
+        p, kind, omega, mode, part = eng._finish(p_min, vals, vecs, m, members, divergence)
+        return CriticalLoad(p, kind, omega, p_max, method, mode, part, (), eng.evaluations)
+    grid, flags, brackets = eng.scan(p_min, p_max, n_scan, chunk, all_crossings)
+    crossings = []
+    first = None
+    for a, b in brackets:
+        p, kind, omega, mode, part = eng.refine(a, b)
+        direction = "loss" if a < b else "gain"
+        crossings.append(Crossing(p, direction, kind, omega))
+        if direction == "loss" and (first is None or p < first[0]):
+            first = (p, kind, omega, mode, part)
+    crossings.sort(key=lambda c: c.load)
+    if first is None:
+        return CriticalLoad(None, "none", None, p_max, method, None, None, tuple(crossings), eng.evaluations)
+    p, kind, omega, mode, part = first
+    return CriticalLoad(
+        p, kind, omega, p_max, method, mode, part,
+        tuple(crossings) if all_crossings else (), eng.evaluations,
+    )
+
+
+def critical_load(
+    M,
+    K0,
+    K1,
+    D=None,
+    G=None,
+    p_max: float = 1.0,
+    *,
+    n_scan: int = 64,
+    all_crossings: bool = False,
+) -> CriticalLoad:
+    """Critical load of ``M q'' + (D + G) q' + (K0 + p K1) q = 0``.
+
+    Parameters
+    ----------
+    M, K0, K1 : (n, n) array_like
+        Mass, stiffness at p = 0, and stiffness per unit load (non-symmetric for follower loads).
+    D, G : (n, n) array_like, optional
+        Damping (symmetric) and gyroscopic (skew) matrices.
+    p_max : float
+        Upper end of the search.
+    n_scan : int
+        Number of scan intervals on ``[0, p_max]``.
+    all_crossings : bool
+        Also list every later loss and gain of stability up to ``p_max``.
+
+    Returns
+    -------
+    CriticalLoad
+        ``.load`` is the first critical value from p = 0 (None if stable up to ``p_max``).
+
+    Examples
+    --------
+    Ziegler's pendulum (m = l = c = 1): flutter at ``7/2 - sqrt(2)``.
+
+    >>> import numpy as np
+    >>> r = critical_load([[3, 1], [1, 1]], [[2, -1], [-1, 1]], [[-1, 1], [0, 0]], p_max=5)
+    >>> round(r.load, 10), r.kind
+    (2.0857864376, 'flutter')
+    """
+    fam = LinearFamily.build(M, K0, K1, D, G)
+    return critical_load_family(fam, p_max, n_scan=n_scan, all_crossings=all_crossings)

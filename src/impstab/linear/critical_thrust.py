@@ -1,0 +1,159 @@
+"""Critical thrust of a propulsor model: the first loss of stability from T = 0."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.model import DOF_NAMES, Model
+from .critical import CriticalLoad, Crossing, critical_load_family
+from .linearize import ModelFamily
+
+__all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD"]
+
+#: share of kinetic energy above which a dof is listed among the modes involved
+PARTICIPATION_THRESHOLD = 0.05
+
+
+@dataclass(frozen=True, eq=False)
+class CriticalThrust:
+    """Critical thrust of a model and the mode that goes unstable.
+
+    Attributes
+    ----------
+    thrust : float or None
+        Critical thrust T_c (N); None when stable up to ``thrust_max`` (``kind == "none"``).
+    kind : {"flutter", "divergence", "none"}
+    omega : float or None
+        Angular frequency at onset (rad/s).
+    modes : tuple of str
+        Dofs whose kinetic-energy share in the merging modes is at least 5 %.
+    participation : (6,) array or None
+        Those shares, dof order surge, sway, heave, roll, pitch, yaw.
+    mode_shape : (6,) complex array or None
+        Displacement shape of the critical mode at onset (largest component 1).
+    thrust_max, operating_thrust : float, float or None
+        Search range end and design thrust (N).
+    undamped_thrust : float or None
+        Critical thrust of the same model with every damper removed (equal to ``thrust`` for an
+        undamped model); the gap shows destabilisation by damping.
+    undamped_kind : str
+    linearization : {"equilibrium", "classical"}
+    crossings : tuple of Crossing
+        All stability changes up to ``thrust_max`` (when requested).
+    """
+
+    thrust: float | None
+    kind: str
+    omega: float | None
+    modes: tuple[str, ...]
+    participation: NDArray[np.float64] | None
+    mode_shape: NDArray[np.complex128] | None
+    thrust_max: float
+    operating_thrust: float | None
+    undamped_thrust: float | None
+    undamped_kind: str
+    linearization: str
+    method: str
+    crossings: tuple[Crossing, ...] = field(default_factory=tuple)
+    model_name: str = ""
+
+    @property
+    def frequency_hz(self) -> float | None:
+        """Onset frequency ``omega / 2 pi`` (Hz)."""
+        return None if self.omega is None else self.omega / (2 * np.pi)
+
+    @property
+    def margin(self) -> float | None:
+        """``critical / operating`` (None without an operating thrust or a critical thrust)."""
+        if self.thrust is None or not self.operating_thrust:
+            return None
+        return self.thrust / self.operating_thrust
+
+    def to_dict(self) -> dict:
+        """The JSON object of ``impstab critical --json`` (DESIGN.md), plus extra keys."""
+        from .. import __version__
+
+        return {
+            "critical_thrust": self.thrust,
+            "kind": self.kind,
+            "frequency_hz": self.frequency_hz,
+            "omega": self.omega,
+            "modes": list(self.modes),
+            "thrust_max": self.thrust_max,
+            "operating_thrust": self.operating_thrust,
+            "margin": self.margin,
+            "undamped_critical_thrust": self.undamped_thrust,
+            "linearization": self.linearization,
+            "undamped_kind": self.undamped_kind,
+            "participation": None if self.participation is None else dict(zip(DOF_NAMES, map(float, self.participation))),
+            "crossings": [c.__dict__ for c in self.crossings],
+            "method": self.method,
+            "model": self.model_name,
+            "impstab_version": __version__,
+        }
+
+    def to_json(self) -> str:
+        from ..cli._common import jsonable
+
+        return json.dumps(jsonable(self.to_dict()))
+
+
+def _modes(part: NDArray[np.float64] | None) -> tuple[str, ...]:
+    if part is None:
+        return ()
+    return tuple(n for n, s in zip(DOF_NAMES, part) if s >= PARTICIPATION_THRESHOLD)
+
+
+def critical_thrust(
+    model: Model,
+    *,
+    thrust_max: float | None = None,
+    linearization: str | None = None,
+    n_scan: int = 64,
+    all_crossings: bool = False,
+) -> CriticalThrust:
+    """First loss of stability of ``model`` as the thrust grows from 0 to ``thrust_max``.
+
+    Parameters
+    ----------
+    model : Model
+    thrust_max : float, optional
+        Upper end of the search (N); defaults to ``model.analysis.thrust_max``.
+    linearization : {"equilibrium", "classical"}, optional
+        Defaults to ``model.analysis.linearization``.
+    n_scan : int
+        Scan intervals before refinement (the refinement is exact; the scan only brackets).
+    all_crossings : bool
+        Also list every later loss and gain of stability (restabilisation) up to ``thrust_max``.
+
+    Returns
+    -------
+    CriticalThrust
+    """
+    t_max = float(thrust_max if thrust_max is not None else model.analysis.thrust_max)
+    fam = ModelFamily(model, linearization)
+    res: CriticalLoad = critical_load_family(fam, t_max, n_scan=n_scan, all_crossings=all_crossings)
+    if model.is_damped:
+        und = critical_load_family(ModelFamily(model, linearization, damped=False), t_max, n_scan=n_scan)
+    else:
+        und = res
+    return CriticalThrust(
+        thrust=res.load,
+        kind=res.kind,
+        omega=res.omega,
+        modes=_modes(res.participation),
+        participation=res.participation,
+        mode_shape=res.mode,
+        thrust_max=t_max,
+        operating_thrust=model.thrust.operating,
+        undamped_thrust=und.load,
+        undamped_kind=und.kind,
+        linearization=fam.linearization,  # type: ignore[arg-type]
+        method=res.method,
+        crossings=res.crossings,
+        model_name=model.name,
+    )

@@ -1,0 +1,132 @@
+"""Small-rotation and finite-rotation kinematics shared by the linear and nonlinear models.
+
+Conventions (THEORY 1): ``skew(a) @ b == cross(a, b)``; the rigid-body map of a body point
+at arm ``r`` (from the reference point A) is ``d = rigid_map(r) @ q`` with
+``q = (u_x, u_y, u_z, r_x, r_y, r_z)``; finite rotations are updated with a *spatial*
+increment, ``R <- expm(skew(dphi)) @ R``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "skew",
+    "rigid_map",
+    "rigid_map6",
+    "rotation_from_vector",
+    "rotation_vector",
+    "inverse_left_jacobian",
+    "euler_zyx_to_matrix",
+    "matrix_to_euler_zyx",
+    "block_rotate",
+]
+
+Array = NDArray[np.float64]
+
+
+def skew(a: Array) -> Array:
+    """Skew matrix ``S(a)`` with ``S(a) @ b = a x b``; works on stacks ``(..., 3)``."""
+    a = np.asarray(a, dtype=float)
+    s = np.zeros(a.shape[:-1] + (3, 3))
+    s[..., 0, 1] = -a[..., 2]
+    s[..., 0, 2] = a[..., 1]
+    s[..., 1, 0] = a[..., 2]
+    s[..., 1, 2] = -a[..., 0]
+    s[..., 2, 0] = -a[..., 1]
+    s[..., 2, 1] = a[..., 0]
+    return s
+
+
+def rigid_map(r: Array) -> Array:
+    """``T(r) = [I, -S(r)]`` (3 x 6): displacement of the body point at arm ``r``."""
+    r = np.asarray(r, dtype=float)
+    t = np.zeros(r.shape[:-1] + (3, 6))
+    t[..., :, :3] = np.eye(3)
+    t[..., :, 3:] = -skew(r)
+    return t
+
+
+def rigid_map6(r: Array) -> Array:
+    """``[[I, -S(r)], [0, I]]`` (6 x 6): translation and rotation of the body point at ``r``."""
+    r = np.asarray(r, dtype=float)
+    t = np.zeros(r.shape[:-1] + (6, 6))
+    t[..., :3, :] = rigid_map(r)
+    t[..., 3:, 3:] = np.eye(3)
+    return t
+
+
+def rotation_from_vector(phi: Array) -> Array:
+    """Rotation matrix ``exp(S(phi))`` (Rodrigues), accurate for small and large angles."""
+    phi = np.asarray(phi, dtype=float)
+    theta = float(np.linalg.norm(phi))
+    s = skew(phi)
+    if theta < 1e-4:
+        t2 = theta * theta
+        a = 1.0 - t2 / 6.0 + t2 * t2 / 120.0
+        b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
+    else:
+        a = np.sin(theta) / theta
+        b = (1.0 - np.cos(theta)) / (theta * theta)
+    return np.eye(3) + a * s + b * (s @ s)
+
+
+def rotation_vector(rot: Array) -> Array:
+    """Rotation vector ``phi`` with ``exp(S(phi)) = rot`` (angle below pi)."""
+    rot = np.asarray(rot, dtype=float)
+    c = np.clip(0.5 * (np.trace(rot) - 1.0), -1.0, 1.0)
+    theta = float(np.arccos(c))
+    w = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
+    if theta < 1e-4:
+        return w * (1.0 + theta * theta / 6.0)
+    return w * theta / np.sin(theta)
+
+
+def _jinv_coefficient(theta: float) -> float:
+    # c(theta) = 1/theta^2 - (1 + cos theta) / (2 theta sin theta)
+    if theta < 1e-3:
+        t2 = theta * theta
+        return 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
+    return 1.0 / theta**2 - (1.0 + np.cos(theta)) / (2.0 * theta * np.sin(theta))
+
+
+def inverse_left_jacobian(phi: Array) -> Array:
+    """``J_l^{-1}(phi)``: rate of the rotation vector per spatial rotation increment.
+
+    If ``R = exp(S(phi))`` and ``R <- exp(S(dphi)) R``, then ``phi <- phi + J_l^{-1}(phi) dphi``
+    to first order.
+    """
+    phi = np.asarray(phi, dtype=float)
+    s = skew(phi)
+    return np.eye(3) - 0.5 * s + _jinv_coefficient(float(np.linalg.norm(phi))) * (s @ s)
+
+
+def euler_zyx_to_matrix(phi: float, theta: float, psi: float) -> Array:
+    """Rotation body -> hull for the z-y-x Euler sequence (the paper's ``J1``, eq. 4)."""
+    cf, sf = np.cos(phi), np.sin(phi)
+    ct, st = np.cos(theta), np.sin(theta)
+    cp, sp = np.cos(psi), np.sin(psi)
+    return np.array(
+        [
+            [cp * ct, -sp * cf + cp * st * sf, sp * sf + cp * cf * st],
+            [sp * ct, cp * cf + sp * st * sf, -cp * sf + sp * st * cf],
+            [-st, ct * sf, ct * cf],
+        ]
+    )
+
+
+def matrix_to_euler_zyx(rot: Array) -> tuple[float, float, float]:
+    """Euler angles ``(phi, theta, psi)`` (z-y-x sequence) of a rotation body -> hull."""
+    theta = float(np.arcsin(np.clip(-rot[2, 0], -1.0, 1.0)))
+    phi = float(np.arctan2(rot[2, 1], rot[2, 2]))
+    psi = float(np.arctan2(rot[1, 0], rot[0, 0]))
+    return phi, theta, psi
+
+
+def block_rotate(matrix6: Array, rot: Array) -> Array:
+    """``blockdiag(R, R) @ A @ blockdiag(R, R).T`` for a 6 x 6 matrix in (translation, rotation)."""
+    big = np.zeros((6, 6))
+    big[:3, :3] = rot
+    big[3:, 3:] = rot
+    return big @ matrix6 @ big.T

@@ -1,0 +1,208 @@
+"""Linearization of a :class:`~impstab.model.Model` at a thrust (THEORY 4).
+
+``linearize(model, thrust)`` returns one :class:`LinearSystem`; :class:`ModelFamily` evaluates
+stacks of systems for arrays of thrusts in one compiled loop (used by the locus, the critical
+thrust search and design studies).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import ModelError, NumericalError
+from ..model.model import LINEARIZATIONS, Model
+from .system import LinearSystem
+from .tangent import linearize_batch
+
+__all__ = ["linearize", "ModelFamily", "PackedModel", "pack_model"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class PackedModel:
+    """A model flattened to arrays for the compiled kernels."""
+
+    mass6: Array
+    positions: Array
+    stiffness: Array
+    damping: Array
+    e_dir: Array
+    r_thrust: Array
+    tangency: float
+    preload: bool
+    polar_inertia: float
+    speed: float
+    speed_law: str
+    operating: float | None
+    length_scale: float
+
+    def spins(self, thrusts: Array) -> Array:
+        """Propeller speed Omega (rad/s) at each thrust."""
+        thrusts = np.asarray(thrusts, dtype=float)
+        if self.speed_law == "sqrt-thrust":
+            return self.speed * np.sqrt(np.maximum(thrusts, 0.0) / self.operating)
+        return np.full(thrusts.shape, self.speed)
+
+
+def pack_model(model: Model, damped: bool = True) -> PackedModel:
+    """Flatten ``model`` for the kernels (``damped=False`` drops every damper)."""
+    positions = np.array([m.position for m in model.mounts], dtype=float).reshape(-1, 3)
+    stiffness = np.array([m.stiffness for m in model.mounts], dtype=float).reshape(-1, 6, 6)
+    damping = np.array([m.damping for m in model.mounts], dtype=float).reshape(-1, 6, 6)
+    if not damped:
+        damping = np.zeros_like(damping)
+    arms = np.concatenate([np.linalg.norm(positions, axis=1), [np.linalg.norm(model.thrust.point)]])
+    return PackedModel(
+        mass6=np.ascontiguousarray(model.mass_matrix),
+        positions=np.ascontiguousarray(positions),
+        stiffness=np.ascontiguousarray(stiffness),
+        damping=np.ascontiguousarray(damping),
+        e_dir=np.ascontiguousarray(model.thrust.direction),
+        r_thrust=np.ascontiguousarray(model.thrust.point, dtype=float),
+        tangency=float(model.thrust.tangency),
+        preload=bool(model.thrust.preload_stiffness),
+        polar_inertia=float(model.propeller.polar_inertia),
+        speed=float(model.propeller.speed),
+        speed_law=model.propeller.speed_law,
+        operating=model.thrust.operating,
+        length_scale=float(max(arms.max(initial=0.0), 1e-3)),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class ModelFamily:
+    """The model's linearized systems as a function of thrust, evaluated in batches.
+
+    Parameters
+    ----------
+    model : Model
+    linearization : {"equilibrium", "classical"}, optional
+        Defaults to the model's ``analysis.linearization``.
+    damped : bool
+        False removes every damper (the undamped companion of a damped model).
+    """
+
+    model: Model
+    linearization: str | None = None
+    damped: bool = True
+
+    def __post_init__(self) -> None:
+        lin = self.linearization or self.model.analysis.linearization
+        if lin not in LINEARIZATIONS:
+            raise ModelError("analysis.linearization", lin, f"must be one of {list(LINEARIZATIONS)}")
+        object.__setattr__(self, "linearization", lin)
+        pk = pack_model(self.model, damped=self.damped)
+        object.__setattr__(self, "_packed", pk)
+        object.__setattr__(self, "_affine", self._affine_form(pk, lin))
+
+    @staticmethod
+    def _affine_form(pk: PackedModel, lin: str):
+        """``(M, D, K0, K1, G1, R0-free)`` when K is exactly linear in T, else None.
+
+        The classical form is linear by construction. The equilibrium form is too when linear
+        statics leaves the body unrotated (symmetric layouts, thrust through the elastic centre):
+        then ``R0 = I`` solves the nonlinear statics exactly, the mount forces are the linear
+        ones and the tangent equals the classical matrices.
+        """
+        args = (pk.mass6, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency,
+                pk.preload, 1.0)
+        if lin == "equilibrium":
+            load = np.concatenate([pk.e_dir, np.cross(pk.r_thrust, pk.e_dir)])
+            q0 = np.linalg.solve(_elastic(pk), load)
+            rot = np.abs(q0[3:]).max() * pk.length_scale
+            if rot > 1e-13 * max(np.abs(q0[:3]).max(), 1e-300):
+                return None
+        # K(T) is linear: take K1 from a large thrust so that K0 does not cancel it
+        t = np.array([0.0, 1.0])
+        m, d, g, k, _, _, _ = linearize_batch(t, np.ones(2), *args, False, pk.length_scale)
+        big = 1e8 * max(np.abs(k[0]).max(), 1e-300) / max(np.abs(k[1] - k[0]).max(), 1e-300)
+        kb = linearize_batch(np.array([big]), np.ones(1), *args, False, pk.length_scale)[3][0]
+        return m[0], d[0], k[0], (kb - k[0]) / big, g[0]
+
+    def _affine_matrices(self, p: Array):
+        m, d, k0, k1, g1 = self._affine  # type: ignore[attr-defined]
+        pk = self.packed
+        n = p.size
+        shape = (n, 6, 6)
+        g = g1[None] * (pk.polar_inertia * pk.spins(p))[:, None, None]
+        return (np.broadcast_to(m, shape), np.broadcast_to(d, shape), g, k0[None] + p[:, None, None] * k1[None])
+
+    n = 6
+
+    @property
+    def packed(self) -> PackedModel:
+        return self._packed  # type: ignore[attr-defined]
+
+    def evaluate(self, thrusts: Array):
+        """``M, D, G, K`` stacks and the static poses ``u0, R0`` at each thrust."""
+        pk = self.packed
+        thrusts = np.ascontiguousarray(np.atleast_1d(np.asarray(thrusts, dtype=float)))
+        m, d, g, k, u0, r0, ok = linearize_batch(
+            thrusts, pk.spins(thrusts), pk.mass6, pk.positions, pk.stiffness, pk.damping,
+            pk.e_dir, pk.r_thrust, pk.tangency, pk.preload, pk.polar_inertia,
+            self.linearization == "equilibrium", pk.length_scale,
+        )
+        if not ok.all():
+            bad = thrusts[~ok][0]
+            raise NumericalError(
+                f"no static equilibrium found at thrust {bad:.6g} N (Newton with load stepping did "
+                "not converge): the mounts cannot carry this thrust"
+            )
+        return m, d, g, k, u0, r0
+
+    @property
+    def is_affine(self) -> bool:
+        """True when ``K = K0 + T K1`` exactly (classical, or an equilibrium without rotation)."""
+        return self._affine is not None  # type: ignore[attr-defined]
+
+    def affine_parts(self):
+        """``(M, D, G, K0, K1)`` when the family is exactly affine with constant G, else None."""
+        if self._affine is None:  # type: ignore[attr-defined]
+            return None
+        pk = self.packed
+        if pk.speed_law == "sqrt-thrust" and pk.polar_inertia * pk.speed != 0.0:
+            return None
+        m, d, k0, k1, g1 = self._affine  # type: ignore[attr-defined]
+        return m, d, g1 * pk.polar_inertia * pk.speed, k0, k1
+
+    def matrices(self, p: Array):
+        p = np.atleast_1d(np.asarray(p, dtype=float))
+        if self._affine is not None:  # type: ignore[attr-defined]
+            return self._affine_matrices(p)
+        m, d, g, k, _, _ = self.evaluate(p)
+        return m, d, g, k
+
+
+def _elastic(pk: PackedModel) -> Array:
+    from ..model.mounts import Mount, elastic_stiffness
+
+    return elastic_stiffness([Mount(r, k, c) for r, k, c in zip(pk.positions, pk.stiffness, pk.damping)])
+
+
+def linearize(model: Model, thrust: float, linearization: str | None = None) -> LinearSystem:
+    """Linearized equations of motion of ``model`` at thrust ``thrust`` (N).
+
+    Parameters
+    ----------
+    model : Model
+    thrust : float
+        Thrust magnitude T (N).
+    linearization : {"equilibrium", "classical"}, optional
+        Override the model's setting. ``"equilibrium"`` solves the nonlinear statics (Newton) and
+        returns the exact tangent there, with M, D and G at the deflected pose; ``"classical"``
+        evaluates at the undeformed configuration with mount forces from linear statics, so that
+        ``K = K_c - T K_G`` is exactly linear in T.
+
+    Returns
+    -------
+    LinearSystem
+    """
+    if not np.isfinite(thrust):
+        raise ModelError("thrust", thrust, "must be a finite number")
+    fam = ModelFamily(model, linearization)
+    m, d, g, k, u0, r0 = fam.evaluate(np.array([float(thrust)]))
+    return LinearSystem(m[0], d[0], g[0], k[0], float(thrust), fam.linearization, u0[0], r0[0])

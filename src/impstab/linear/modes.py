@@ -1,0 +1,125 @@
+"""Natural frequencies, damping, growth rates and mode shapes at one thrust."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.model import DOF_NAMES, Model
+from .eigen import kinetic_shares
+from .linearize import linearize
+from .system import LinearSystem
+
+__all__ = ["ModalResult", "modes", "modes_of_system"]
+
+
+@dataclass(frozen=True, eq=False)
+class ModalResult:
+    """Modes of the linearized system at thrust ``thrust``, sorted by frequency.
+
+    One entry per mode: a complex pair counts once (``omega >= 0``); a real eigenvalue (an
+    overdamped or divergent motion) is its own entry with ``omega = 0``.
+
+    Attributes
+    ----------
+    eigenvalues : (k,) complex
+        ``lambda = sigma + i omega`` (1/s).
+    shapes : (6, k) complex
+        Displacement shapes, largest component 1.
+    participation : (k, 6)
+        Kinetic-energy share of each dof in each mode.
+    """
+
+    thrust: float
+    linearization: str
+    eigenvalues: NDArray[np.complex128]
+    shapes: NDArray[np.complex128]
+    participation: NDArray[np.float64]
+
+    @property
+    def omega(self) -> NDArray[np.float64]:
+        """Damped angular frequency (rad/s)."""
+        return np.abs(self.eigenvalues.imag)
+
+    @property
+    def frequency_hz(self) -> NDArray[np.float64]:
+        return self.omega / (2 * np.pi)
+
+    @property
+    def growth_rate(self) -> NDArray[np.float64]:
+        """``sigma = Re(lambda)`` (1/s); positive means growing."""
+        return self.eigenvalues.real
+
+    @property
+    def damping_ratio(self) -> NDArray[np.float64]:
+        """``zeta = -sigma / |lambda|`` (negative for a growing mode)."""
+        mag = np.abs(self.eigenvalues)
+        return np.where(mag > 0, -self.eigenvalues.real / np.where(mag > 0, mag, 1), 0.0)
+
+    @property
+    def stable(self) -> bool:
+        scale = max(np.abs(self.eigenvalues).max(), 1e-300)
+        return bool(np.all(self.growth_rate <= 1e-9 * scale))
+
+    def dominant(self, threshold: float = 0.2) -> list[tuple[str, ...]]:
+        """Dof names carrying at least ``threshold`` of each mode's kinetic energy."""
+        return [tuple(n for n, s in zip(DOF_NAMES, row) if s >= threshold) for row in self.participation]
+
+    def to_dict(self) -> dict:
+        return {
+            "thrust": self.thrust,
+            "linearization": self.linearization,
+            "modes": [
+                {
+                    "omega": float(self.omega[j]),
+                    "frequency_hz": float(self.frequency_hz[j]),
+                    "growth_rate": float(self.growth_rate[j]),
+                    "damping_ratio": float(self.damping_ratio[j]),
+                    "dominant": list(self.dominant()[j]),
+                    "shape_real": self.shapes[:, j].real.tolist(),
+                    "shape_imag": self.shapes[:, j].imag.tolist(),
+                }
+                for j in range(len(self.eigenvalues))
+            ],
+        }
+
+    def to_xarray(self):
+        import xarray as xr
+
+        from .. import __version__
+
+        return xr.Dataset(
+            {
+                "omega": ("mode", self.omega, {"units": "rad/s"}),
+                "frequency_hz": ("mode", self.frequency_hz, {"units": "Hz"}),
+                "growth_rate": ("mode", self.growth_rate, {"units": "1/s"}),
+                "damping_ratio": ("mode", self.damping_ratio, {"units": "1"}),
+                "shape_real": (("dof", "mode"), self.shapes.real),
+                "shape_imag": (("dof", "mode"), self.shapes.imag),
+                "participation": (("mode", "dof"), self.participation),
+            },
+            coords={"mode": np.arange(len(self.eigenvalues)), "dof": list(DOF_NAMES)},
+            attrs={"thrust": self.thrust, "linearization": self.linearization, "impstab_version": __version__},
+        )
+
+
+def modes_of_system(system: LinearSystem) -> ModalResult:
+    """Modes of a :class:`LinearSystem`."""
+    vals, vecs = np.linalg.eig(system.state_matrix())
+    scale = max(np.abs(vals).max(), 1e-300)
+    keep = (vals.imag > 1e-12 * scale) | (np.abs(vals.imag) <= 1e-12 * scale)
+    vals, vecs = vals[keep], vecs[:6, keep]
+    order = np.lexsort((vals.real, np.abs(vals.imag)))
+    vals, vecs = vals[order], vecs[:, order]
+    big = np.argmax(np.abs(vecs), axis=0)
+    piv = vecs[big, np.arange(vecs.shape[1])]
+    shapes = vecs / piv
+    part = np.array([kinetic_shares(shapes[:, [j]], system.M) for j in range(shapes.shape[1])])
+    return ModalResult(system.thrust, system.linearization, vals, shapes, part)
+
+
+def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -> ModalResult:
+    """Natural frequencies, damping ratios, growth rates and mode shapes at thrust ``thrust`` (N)."""
+    return modes_of_system(linearize(model, thrust, linearization))

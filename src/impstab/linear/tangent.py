@@ -1,0 +1,312 @@
+"""Exact generalized forces and tangent stiffness of the mounted body under thrust (THEORY 4).
+
+The body pose is ``(u, R)``: translation of A and rotation body -> hull. Generalized coordinates
+are ``q = (du, dphi)`` with a *spatial* rotation increment, ``R <- exp(S(dphi)) R``; generalized
+forces are the resultant force on the body and the moment about the current position of A
+(hull frame). The stiffness is ``K = -dQ/dq``.
+
+Each mount is an elastic element with potential ``V = 1/2 e^T k e`` on its body-end deflection
+``e = (u + R r - r, phi)`` with ``phi = log(R)`` (rotation vector), so that
+``Q_i = -B_i^T k_i e_i``, ``B_i = [[I, -S(rho_i)], [0, J_l^{-1}(phi)]]``, ``rho_i = R r_i``.
+For the paper's mount (translation block only) this is ``f_i = -k_i d_i`` at the arm ``rho_i``.
+The tangent is ``sum B_i^T k_i B_i`` plus the preload (geometric) part
+``-S(f_i) S(rho_i) + H(phi, g_phi) J_l^{-1}`` plus the thrust part
+``[[0, S(f_F)], [0, -S(f_F + f_D) S(rho_T) + S(rho_T) S(f_F)]]``.
+
+The functions are compiled with numba (``cache=True``); with ``NUMBA_DISABLE_JIT=1`` the same
+code runs as plain Python/NumPy and gives identical results.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch"]
+
+
+@njit(cache=True)
+def _skew(a):
+    s = np.zeros((3, 3))
+    s[0, 1] = -a[2]
+    s[0, 2] = a[1]
+    s[1, 0] = a[2]
+    s[1, 2] = -a[0]
+    s[2, 0] = -a[1]
+    s[2, 1] = a[0]
+    return s
+
+
+@njit(cache=True)
+def _cross(a, b):
+    out = np.empty(3)
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+    return out
+
+
+@njit(cache=True)
+def _exp_so3(phi):
+    theta = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
+    s = _skew(phi)
+    if theta < 1e-4:
+        t2 = theta * theta
+        a = 1.0 - t2 / 6.0 + t2 * t2 / 120.0
+        b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
+    else:
+        a = math.sin(theta) / theta
+        b = (1.0 - math.cos(theta)) / (theta * theta)
+    return np.eye(3) + a * s + b * (s @ s)
+
+
+@njit(cache=True)
+def _log_so3(rot):
+    c = 0.5 * (rot[0, 0] + rot[1, 1] + rot[2, 2] - 1.0)
+    c = min(1.0, max(-1.0, c))
+    theta = math.acos(c)
+    w = np.empty(3)
+    w[0] = 0.5 * (rot[2, 1] - rot[1, 2])
+    w[1] = 0.5 * (rot[0, 2] - rot[2, 0])
+    w[2] = 0.5 * (rot[1, 0] - rot[0, 1])
+    if theta < 1e-4:
+        return w * (1.0 + theta * theta / 6.0)
+    return w * (theta / math.sin(theta))
+
+
+@njit(cache=True)
+def _jinv_coeffs(theta):
+    # c(theta) = 1/theta^2 - cot(theta/2) / (2 theta);  c1 = c'(theta) / theta
+    if theta < 0.25:
+        t2 = theta * theta
+        c = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2**3 / 1209600.0 + t2**4 / 47900160.0
+        c1 = 1.0 / 360.0 + t2 / 7560.0 + t2 * t2 / 201600.0 + t2**3 / 5987520.0
+        return c, c1
+    half = 0.5 * theta
+    cot = math.cos(half) / math.sin(half)
+    c = 1.0 / theta**2 - cot / (2.0 * theta)
+    dc = -2.0 / theta**3 + 1.0 / (4.0 * theta * math.sin(half) ** 2) + cot / (2.0 * theta**2)
+    return c, dc / theta
+
+
+@njit(cache=True)
+def _jinv(phi):
+    theta = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
+    c, _ = _jinv_coeffs(theta)
+    s = _skew(phi)
+    return np.eye(3) - 0.5 * s + c * (s @ s)
+
+
+@njit(cache=True)
+def _d_jinvT_w(phi, w):
+    """H = d(J_l^{-1}(phi)^T w)/dphi for fixed w."""
+    theta2 = phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2
+    c, c1 = _jinv_coeffs(math.sqrt(theta2))
+    pw = phi[0] * w[0] + phi[1] * w[1] + phi[2] * w[2]
+    h = -0.5 * _skew(w)
+    for i in range(3):
+        for j in range(3):
+            h[i, j] += c * (pw * (1.0 if i == j else 0.0) + phi[i] * w[j] - 2.0 * w[i] * phi[j])
+            h[i, j] += c1 * (phi[i] * pw - theta2 * w[i]) * phi[j]
+    return h
+
+
+@njit(cache=True)
+def pose_forces(u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, tangency):
+    """Generalized forces and tangent pieces at the pose ``(u, rot)`` under thrust ``T``.
+
+    Returns
+    -------
+    q_force : (6,) generalized force (N, N m about the current A, hull frame)
+    k_elastic : (6, 6) ``sum B^T k B``
+    k_preload : (6, 6) mount preload (geometric) stiffness
+    k_thrust : (6, 6) load stiffness of the thrust
+    d_mount : (6, 6) ``sum B^T c B``
+    """
+    nm = positions.shape[0]
+    q_force = np.zeros(6)
+    k_el = np.zeros((6, 6))
+    k_pre = np.zeros((6, 6))
+    k_thr = np.zeros((6, 6))
+    d_m = np.zeros((6, 6))
+    phi = _log_so3(rot)
+    jinv = _jinv(phi)
+    for i in range(nm):
+        r = positions[i]
+        rho = rot @ r
+        e = np.empty(6)
+        e[:3] = u + rho - r
+        e[3:] = phi
+        b = np.zeros((6, 6))
+        b[0, 0] = 1.0
+        b[1, 1] = 1.0
+        b[2, 2] = 1.0
+        b[:3, 3:] = -_skew(rho)
+        b[3:, 3:] = jinv
+        g = stiffness[i] @ e
+        f = -g[:3]
+        gphi = g[3:].copy()
+        m = -(jinv.T @ gphi)
+        q_force[:3] += f
+        q_force[3:] += _cross(rho, f) + m
+        k_el += b.T @ stiffness[i] @ b
+        d_m += b.T @ damping[i] @ b
+        k_pre[3:, 3:] += -_skew(f) @ _skew(rho)
+        if gphi[0] != 0.0 or gphi[1] != 0.0 or gphi[2] != 0.0:
+            k_pre[3:, 3:] += _d_jinvT_w(phi, gphi) @ jinv
+    rho_t = rot @ r_thrust
+    f_f = tangency * thrust * (rot @ e_dir)
+    f_d = (1.0 - tangency) * thrust * e_dir
+    f_t = f_f + f_d
+    q_force[:3] += f_t
+    q_force[3:] += _cross(rho_t, f_t)
+    k_thr[:3, 3:] = _skew(f_f)
+    k_thr[3:, 3:] = -_skew(f_t) @ _skew(rho_t) + _skew(rho_t) @ _skew(f_f)
+    return q_force, k_el, k_pre, k_thr, d_m
+
+
+@njit(cache=True)
+def static_equilibrium_packed(
+    thrust, u0, rot0, positions, stiffness, damping, e_dir, r_thrust, tangency, length_scale
+):
+    """Newton's method for the nonlinear statics ``Q(u, R) = 0`` from the start ``(u0, rot0)``.
+
+    Uses the full tangent (preload included) and load stepping when a full step fails.
+    Returns ``(u, rot, iterations, converged)``.
+    """
+    u = u0.copy()
+    rot = rot0.copy()
+    total = 0
+    for n_sub in (1, 4, 16, 64):
+        u = u0.copy()
+        rot = rot0.copy()
+        ok = True
+        for k in range(1, n_sub + 1):
+            load = thrust * k / n_sub
+            converged = False
+            small = 0
+            for it in range(60):
+                qf, kel, kpre, kthr, _ = pose_forces(
+                    u, rot, load, positions, stiffness, damping, e_dir, r_thrust, tangency
+                )
+                step = np.linalg.solve(kel + kpre + kthr, qf)
+                total += 1
+                if not np.all(np.isfinite(step)):
+                    break
+                u = u + step[:3]
+                rot = _exp_so3(step[3:]) @ rot
+                size = max(np.max(np.abs(step[:3])) / length_scale, np.max(np.abs(step[3:])))
+                if size < 1e-13:
+                    small += 1
+                    if small >= 2 or size < 1e-16:
+                        converged = True
+                        break
+                if size > 1.0:
+                    break
+            if not converged:
+                ok = False
+                break
+        if ok:
+            return u, rot, total, True
+    return u, rot, total, False
+
+
+@njit(cache=True)
+def _block_rotate(mat, rot):
+    big = np.zeros((6, 6))
+    big[:3, :3] = rot
+    big[3:, 3:] = rot
+    return big @ mat @ big.T
+
+
+@njit(cache=True)
+def linearize_batch(
+    thrusts, spins, mass6, positions, stiffness, damping, e_dir, r_thrust, tangency,
+    preload, polar_inertia, equilibrium, length_scale,
+):
+    """Linearized matrices ``M, D, G, K`` (stacks ``(N, 6, 6)``) at each thrust.
+
+    ``equilibrium=True``: at the nonlinear static equilibrium (warm-started along the sorted
+    thrusts); otherwise the classical form at the undeformed configuration with mount forces
+    from linear statics. ``spins`` are the propeller speeds Omega (rad/s) at each thrust.
+    Returns ``M, D, G, K, u0 (N, 3), R0 (N, 3, 3), converged (N,)``.
+    """
+    n = thrusts.shape[0]
+    m_out = np.zeros((n, 6, 6))
+    d_out = np.zeros((n, 6, 6))
+    g_out = np.zeros((n, 6, 6))
+    k_out = np.zeros((n, 6, 6))
+    u_out = np.zeros((n, 3))
+    r_out = np.zeros((n, 3, 3))
+    ok_out = np.ones(n, dtype=np.bool_)
+    nm = positions.shape[0]
+    # condensed elastic stiffness at rest (classical statics)
+    k_c = np.zeros((6, 6))
+    eye3 = np.eye(3)
+    for i in range(nm):
+        t6 = np.zeros((6, 6))
+        t6[:3, :3] = eye3
+        t6[:3, 3:] = -_skew(positions[i])
+        t6[3:, 3:] = eye3
+        k_c += t6.T @ stiffness[i] @ t6
+    order = np.argsort(np.abs(thrusts))
+    u_prev = np.zeros(3)
+    r_prev = np.eye(3)
+    for j in range(n):
+        idx = order[j]
+        thrust = thrusts[idx]
+        if equilibrium:
+            u, rot, _, conv = static_equilibrium_packed(
+                thrust, u_prev, r_prev, positions, stiffness, damping, e_dir, r_thrust, tangency,
+                length_scale,
+            )
+            if not conv:
+                u, rot, _, conv = static_equilibrium_packed(
+                    thrust, np.zeros(3), np.eye(3), positions, stiffness, damping, e_dir, r_thrust,
+                    tangency, length_scale,
+                )
+            ok_out[idx] = conv
+            if conv:
+                u_prev = u
+                r_prev = rot
+            qf, kel, kpre, kthr, dm = pose_forces(
+                u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, tangency
+            )
+        else:
+            u = np.zeros(3)
+            rot = np.eye(3)
+            load = np.zeros(6)
+            load[:3] = thrust * e_dir
+            load[3:] = _cross(r_thrust, thrust * e_dir)
+            q0 = np.linalg.solve(k_c, load)
+            kel = k_c.copy()
+            kpre = np.zeros((6, 6))
+            dm = np.zeros((6, 6))
+            for i in range(nm):
+                r = positions[i]
+                t6 = np.zeros((6, 6))
+                t6[:3, :3] = eye3
+                t6[:3, 3:] = -_skew(r)
+                t6[3:, 3:] = eye3
+                g = stiffness[i] @ (t6 @ q0)
+                f = -g[:3]
+                kpre[3:, 3:] += -_skew(f) @ _skew(r) - 0.5 * _skew(g[3:])
+                dm += t6.T @ damping[i] @ t6
+            f_f = tangency * thrust * e_dir
+            f_t = thrust * e_dir
+            kthr = np.zeros((6, 6))
+            kthr[:3, 3:] = _skew(f_f)
+            kthr[3:, 3:] = -_skew(f_t) @ _skew(r_thrust) + _skew(r_thrust) @ _skew(f_f)
+        k = kel + kthr
+        if preload:
+            k = k + kpre
+        m_out[idx] = _block_rotate(mass6, rot)
+        d_out[idx] = dm
+        h = polar_inertia * spins[idx] * (rot @ e_dir)
+        g_out[idx, 3:, 3:] = -_skew(h)
+        k_out[idx] = k
+        u_out[idx] = u
+        r_out[idx] = rot
+    return m_out, d_out, g_out, k_out, u_out, r_out, ok_out

@@ -1,0 +1,240 @@
+"""From a model file (or a plain dict) to a validated, assembled :class:`Model`.
+
+Every failure is a :class:`~impstab.errors.ModelError` naming the field, the value and the rule.
+"""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import ValidationError
+
+from ..errors import ModelError
+from .body import RigidBody
+from .fluid import FluidLoading, Hull
+from .model import AnalysisSettings, Model
+from .mounts import Mount, axial_shear_matrix, elastic_stiffness, ring_positions
+from .schema import ModelFile
+from .thrust import Propeller, Thrust
+
+__all__ = ["load_model", "model_from_dict", "format_location"]
+
+_SYM_TOL = 1e-9
+
+
+def format_location(loc: tuple) -> str:
+    """``("mounts", 1, "k_axial")`` -> ``"mounts[1].k_axial"``."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "(file)"
+
+
+def _lookup(data: Any, loc: tuple) -> Any:
+    cur = data
+    for part in loc:
+        try:
+            cur = cur[part]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return cur
+
+
+def _from_validation_error(err: ValidationError, data: Any) -> ModelError:
+    first = err.errors()[0]
+    loc = tuple(p for p in first["loc"] if not (isinstance(p, str) and p.startswith(("list[", "function-"))))
+    # drop union-branch labels pydantic inserts, e.g. "list[float]"
+    field = format_location(loc)
+    value = first.get("input", _lookup(data, loc))
+    kind = first["type"]
+    if kind == "extra_forbidden":
+        return ModelError(field, value, "unknown key (check the spelling against the model-file schema)")
+    if kind == "missing":
+        return ModelError(field, None, "is required")
+    ctx = first.get("ctx") or {}
+    if kind in ("too_short", "too_long") and "actual_length" in ctx:
+        want = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
+        return ModelError(field, value, f"must have {want} items, not {ctx['actual_length']}")
+    msg = first["msg"].replace("Value error, ", "").replace("Input should be", "must be")
+    return ModelError(field, value, msg[0].lower() + msg[1:])
+
+
+def _unit(vec: list[float], field: str) -> np.ndarray:
+    v = np.asarray(vec, dtype=float)
+    n = float(np.linalg.norm(v))
+    if n == 0.0:
+        raise ModelError(field, vec, "must be a non-zero vector")
+    return v / n
+
+
+def _symmetric_psd(mat: np.ndarray, field: str, definite: bool = False) -> None:
+    scale = max(float(np.abs(mat).max()), 1e-300)
+    if np.abs(mat - mat.T).max() > _SYM_TOL * scale:
+        raise ModelError(field, mat.tolist(), "must be symmetric")
+    ev = np.linalg.eigvalsh(0.5 * (mat + mat.T))
+    if definite and ev.min() <= _SYM_TOL * ev.max():
+        raise ModelError(field, mat.tolist(), "must be positive definite")
+    if ev.min() < -_SYM_TOL * scale:
+        raise ModelError(field, mat.tolist(), "must be positive semi-definite")
+
+
+def _inertia(spec: list, field: str) -> np.ndarray:
+    arr = np.asarray(spec, dtype=float)
+    inertia = np.diag(arr) if arr.ndim == 1 else arr
+    _symmetric_psd(inertia, field, definite=True)
+    p = np.linalg.eigvalsh(inertia)
+    if p[2] > p[0] + p[1] * (1 + 1e-12):
+        raise ModelError(
+            field, spec, f"principal moments {p.round(12).tolist()} break the triangle inequality "
+            "(each must not exceed the sum of the other two)"
+        )
+    return inertia
+
+
+def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
+    mounts: list[Mount] = []
+    for i, m in enumerate(doc.mounts):
+        f = f"mounts[{i}]"
+        pos = np.asarray(m.position, float)
+        if m.stiffness is not None:
+            for key in ("k_axial", "k_shear"):
+                if getattr(m, key) is not None:
+                    raise ModelError(f"{f}.{key}", getattr(m, key), "give either 'stiffness' (6x6) or k_axial/k_shear, not both")
+            k6 = np.asarray(m.stiffness, float)
+            _symmetric_psd(k6, f"{f}.stiffness")
+        else:
+            for key in ("k_axial", "k_shear"):
+                if getattr(m, key) is None:
+                    raise ModelError(f"{f}.{key}", None, "is required (or give a full 6x6 'stiffness')")
+            axis = _unit(m.axis, f"{f}.axis")
+            k6 = np.zeros((6, 6))
+            k6[:3, :3] = axial_shear_matrix(axis, m.k_axial, m.k_shear)
+        if m.damping is not None:
+            if m.c_axial or m.c_shear:
+                raise ModelError(f"{f}.damping", "6x6", "give either 'damping' (6x6) or c_axial/c_shear, not both")
+            c6 = np.asarray(m.damping, float)
+            _symmetric_psd(c6, f"{f}.damping")
+        else:
+            axis = _unit(m.axis, f"{f}.axis")
+            c6 = np.zeros((6, 6))
+            c6[:3, :3] = axial_shear_matrix(axis, m.c_axial, m.c_shear)
+        mounts.append(Mount(pos, k6, c6))
+    for i, ring in enumerate(doc.mount_rings):
+        f = f"mount_rings[{i}]"
+        axis = _unit(ring.axis, f"{f}.axis")
+        for pos in ring_positions(ring.count, ring.radius, ring.x, ring.start_angle):
+            mounts.append(Mount.axial_shear(pos, axis, ring.k_axial, ring.k_shear, ring.c_axial, ring.c_shear))
+    if not mounts:
+        raise ModelError("mounts", [], "the model needs at least one mount or mount ring")
+    kc = elastic_stiffness(mounts)
+    ev = np.linalg.eigvalsh(kc)
+    if ev.min() <= 1e-9 * ev.max():
+        vec = np.linalg.eigh(kc)[1][:, 0]
+        names = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+        free = [names[j] for j in np.flatnonzero(np.abs(vec) > 0.3)]
+        raise ModelError(
+            "mounts", f"{len(mounts)} mounts",
+            f"leave a rigid-body motion free (involving {', '.join(free)}): the mounts must restrain all six",
+        )
+    return tuple(mounts)
+
+
+def _fluid(doc: ModelFile) -> tuple[FluidLoading, Hull | None]:
+    hull = None
+    if doc.hull is not None:
+        hull = Hull(doc.hull.radius, doc.hull.length, np.asarray(doc.hull.center, float))
+    spec = doc.fluid
+    if spec is None or spec.model == "none":
+        if spec is not None and spec.added_mass is not None:
+            raise ModelError("fluid.added_mass", "6x6", "is only read with fluid.model = 'matrix'")
+        return FluidLoading(), hull
+    if spec.model == "matrix":
+        if spec.added_mass is None:
+            raise ModelError("fluid.added_mass", None, "is required with fluid.model = 'matrix' (6x6 about A)")
+        mat = np.asarray(spec.added_mass, float)
+        _symmetric_psd(mat, "fluid.added_mass")
+        return FluidLoading("matrix", spec.density, spec.sound_speed, mat), hull
+    if spec.added_mass is not None:
+        raise ModelError("fluid.added_mass", "6x6", f"is only read with fluid.model = 'matrix', not {spec.model!r}")
+    if hull is None:
+        raise ModelError("hull", None, f"is required with fluid.model = {spec.model!r} (radius, length, center)")
+    if spec.density is None:
+        raise ModelError("fluid.density", None, f"is required with fluid.model = {spec.model!r}")
+    return FluidLoading.from_hull(spec.model, hull, spec.density, spec.sound_speed), hull
+
+
+def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
+    b = doc.body
+    inertia = _inertia(b.inertia, "body.inertia")
+    body = RigidBody(b.mass, np.asarray(b.cg, float), inertia)
+    mounts = _mounts(doc)
+    t = doc.thrust
+    thrust = Thrust(
+        np.asarray(t.point, float), _unit(t.direction, "thrust.direction"), t.tangency, t.operating,
+        t.preload_stiffness,
+    )
+    prop = doc.propeller or Propeller()
+    if doc.propeller is not None:
+        prop = Propeller(doc.propeller.polar_inertia, doc.propeller.speed, doc.propeller.speed_law)
+        if prop.speed_law == "sqrt-thrust" and t.operating is None:
+            raise ModelError("propeller.speed_law", "sqrt-thrust", "needs thrust.operating (the speed is given at the operating thrust)")
+    thrust_max = doc.analysis.thrust_max
+    if thrust_max is None:
+        if t.operating is None:
+            raise ModelError("analysis.thrust_max", None, "is required when thrust.operating is not given")
+        thrust_max = 10.0 * t.operating
+    fluid, hull = _fluid(doc)
+    return Model(
+        body=body, mounts=mounts, thrust=thrust,
+        analysis=AnalysisSettings(float(thrust_max), doc.analysis.linearization),
+        propeller=prop, fluid=fluid, hull=hull, name=name, source=source,
+    )
+
+
+def model_from_dict(data: dict, name: str | None = None, source: str | None = None) -> Model:
+    """Validate and assemble a model from the parsed contents of a model file."""
+    if not isinstance(data, dict):
+        raise ModelError("(file)", type(data).__name__, "must be a table of model keys")
+    if "schema_version" not in data:
+        raise ModelError("schema_version", None, "is required (schema_version = 1)")
+    try:
+        doc = ModelFile.model_validate(data)
+    except ValidationError as err:
+        raise _from_validation_error(err, data) from None
+    return _assemble(doc, doc.name or name or "model", source)
+
+
+def read_toml(path: str | os.PathLike[str], what: str = "model file") -> dict:
+    """Read a TOML file, turning every I/O or syntax problem into a one-line ModelError."""
+    p = Path(path)
+    try:
+        text = p.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise ModelError(what, str(p), "file not found") from None
+    except IsADirectoryError:
+        raise ModelError(what, str(p), "is a directory, not a file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ModelError(what, str(p), f"cannot be read ({exc.__class__.__name__}: {exc})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError(what, str(p), f"is not valid TOML ({exc})") from None
+
+
+def load_model(path: str | os.PathLike[str]) -> Model:
+    """Read, validate and assemble a model file (TOML, schema_version 1, SI units).
+
+    Raises
+    ------
+    ModelError
+        With a one-line message naming the field, the value and the rule.
+    """
+    data = read_toml(path)
+    return model_from_dict(data, name=Path(path).stem, source=str(path))

@@ -1,0 +1,87 @@
+"""The assembled propulsor model: a frozen, picklable description in SI units."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .body import RigidBody
+from .fluid import FluidLoading, Hull
+from .mounts import Mount, elastic_stiffness, mount_damping
+from .thrust import Propeller, Thrust
+
+__all__ = ["Model", "AnalysisSettings", "DOF_NAMES", "LINEARIZATIONS"]
+
+Array = NDArray[np.float64]
+
+DOF_NAMES = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+LINEARIZATIONS = ("equilibrium", "classical")
+
+
+@dataclass(frozen=True)
+class AnalysisSettings:
+    """Settings of the stability analysis.
+
+    Parameters
+    ----------
+    thrust_max : float
+        Upper end of the critical-thrust search (N).
+    linearization : {"equilibrium", "classical"}
+        ``"equilibrium"`` linearizes at the nonlinear static equilibrium under thrust (default);
+        ``"classical"`` at the undeformed configuration, exactly linear in thrust (paper eq. 21).
+    """
+
+    thrust_max: float
+    linearization: str = "equilibrium"
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """A soft-mounted propulsor: rigid body, mounts, thrust, propeller and fluid loading.
+
+    Build it in code or with :func:`impstab.load_model`. It is immutable and never re-validated;
+    :meth:`with_` returns a modified copy.
+    """
+
+    body: RigidBody
+    mounts: tuple[Mount, ...]
+    thrust: Thrust
+    analysis: AnalysisSettings
+    propeller: Propeller = field(default_factory=Propeller)
+    fluid: FluidLoading = field(default_factory=FluidLoading)
+    hull: Hull | None = None
+    name: str = "model"
+    source: str | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mounts", tuple(self.mounts))
+
+    def with_(self, **changes: object) -> "Model":
+        """A copy with some fields replaced (``dataclasses.replace``)."""
+        return replace(self, **changes)
+
+    @property
+    def mass_matrix(self) -> Array:
+        """Total 6 x 6 mass matrix about A at rest: rigid body plus added mass (body frame)."""
+        return self.body.mass_matrix() + self.fluid.added_mass
+
+    @property
+    def elastic_stiffness(self) -> Array:
+        """Condensed elastic mount stiffness ``K_c`` about A at rest."""
+        return elastic_stiffness(self.mounts)
+
+    @property
+    def damping_matrix(self) -> Array:
+        """Condensed mount damping ``D`` about A at rest."""
+        return mount_damping(self.mounts)
+
+    @property
+    def is_damped(self) -> bool:
+        return any(np.any(m.damping != 0) for m in self.mounts)
+
+    def undamped(self) -> "Model":
+        """The same model with every mount damper removed."""
+        mounts = tuple(Mount(m.position, m.stiffness, np.zeros((6, 6))) for m in self.mounts)
+        return replace(self, mounts=mounts)

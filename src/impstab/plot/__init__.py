@@ -1,0 +1,1 @@
+"""Drawing of result objects with matplotlib; imported lazily, nothing configured at import."""

@@ -1,0 +1,60 @@
+"""Shared fixtures: example paths and model builders."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+
+@pytest.fixture
+def examples() -> Path:
+    return EXAMPLES
+
+
+def ring_model_dict(**over) -> dict:
+    """The symmetric three-mount ring as a model-file dict, with top-level overrides."""
+    d = {
+        "schema_version": 1,
+        "name": "ring",
+        "body": {"mass": 100.0, "inertia": [1.0, 6.0, 6.0]},
+        "mount_rings": [
+            {"count": 3, "radius": 0.15, "x": 0.3, "start_angle": 90.0, "k_axial": 1.0e5, "k_shear": 2.0e4}
+        ],
+        "thrust": {"operating": 2000.0},
+        "analysis": {"thrust_max": 30000.0},
+    }
+    d.update(over)
+    return d
+
+
+def asymmetric_model_dict(**over) -> dict:
+    """An asymmetric layout: tilted axes, a full 6x6 mount, cg offset, off-axis thrust."""
+    d = {
+        "schema_version": 1,
+        "name": "asym",
+        "body": {"mass": 120.0, "cg": [0.05, 0.01, -0.005], "inertia": [[1.4, 0.05, 0.0], [0.05, 7.5, 0.1], [0.0, 0.1, 7.0]]},
+        "mounts": [
+            {"position": [0.30, 0.16, 0.02], "axis": [1.0, 0.1, 0.0], "k_axial": 1.2e5, "k_shear": 2.2e4, "c_axial": 40.0, "c_shear": 8.0},
+            {"position": [0.28, -0.05, 0.15], "axis": [1.0, 0.0, 0.15], "k_axial": 0.9e5, "k_shear": 1.8e4},
+            {"position": [0.33, -0.09, -0.13], "axis": [1.0, -0.05, -0.05], "k_axial": 1.0e5, "k_shear": 2.0e4},
+            {
+                "position": [-0.20, 0.0, -0.14],
+                "stiffness": [
+                    [3.0e4, 0, 0, 0, 500.0, 0],
+                    [0, 1.0e4, 0, -300.0, 0, 0],
+                    [0, 0, 1.0e4, 0, 0, 0],
+                    [0, -300.0, 0, 800.0, 0, 0],
+                    [500.0, 0, 0, 0, 900.0, 0],
+                    [0, 0, 0, 0, 0, 700.0],
+                ],
+            },
+        ],
+        "thrust": {"point": [-0.1, 0.01, 0.02], "direction": [1.0, 0.01, -0.02], "tangency": 0.8, "operating": 3000.0},
+        "analysis": {"thrust_max": 60000.0},
+    }
+    d.update(over)
+    return d
