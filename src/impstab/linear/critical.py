@@ -109,6 +109,7 @@ class _Engine:
         self.family = family
         self.n = family.n
         self.evaluations = 0
+        self._cache: dict[float, tuple] = {}
         # damping and gyroscopic terms may depend on the load (a propeller speed that follows it)
         _, d, g, _ = family.matrices(np.array([0.0, 0.5 * p_max, p_max]))
         self.damped = bool(np.any(d != 0))
@@ -168,10 +169,18 @@ class _Engine:
 
     # -- eigen-decomposition at one load ------------------------------------------------------
     def decompose(self, p: float):
-        ops, m = self.operators(np.array([p]))
-        self.evaluations += 1
-        vals, vecs = np.linalg.eig(ops[0])
-        return vals, vecs, m[0]
+        """Eigenvalues, eigenvectors and mass at one load (cached for the engine's lifetime)."""
+        hit = self._cache.get(p)
+        if hit is None:
+            if self.ops is not None:
+                op, m = self.ops[0] + p * self.ops[1], self.mass
+            else:
+                ops, ms = self.operators(np.array([p]))
+                op, m = ops[0], ms[0]
+            self.evaluations += 1
+            vals, vecs = np.linalg.eig(op)
+            hit = self._cache[p] = (vals, vecs, m, op)
+        return hit[:3]
 
     def unstable_cluster(self, vals: Array) -> tuple[Array, bool, bool]:
         """Indices of the cluster that is unstable, whether it is unique, and if divergent."""
@@ -210,14 +219,17 @@ class _Engine:
 
     @staticmethod
     def select(vecs: Array, proj: tuple[Array, Array], k: int) -> tuple[Array, bool]:
-        """The ``k`` eigenvectors lying most in the cluster subspace, and whether that is clear."""
+        """The ``k`` eigenvectors lying most in the cluster subspace, and whether that is clear.
+
+        ``vecs`` are unit columns (as LAPACK returns them); the share of each is the norm of its
+        oblique projection onto the cluster subspace.
+        """
         v_c, w_c = proj
-        norms = np.linalg.norm(vecs, axis=0)
-        share = np.linalg.norm(v_c @ (w_c @ vecs), axis=0) / norms
+        y = v_c @ (w_c @ vecs)
+        share = (y.real**2 + y.imag**2).sum(axis=0)
         order = np.argsort(-share)
-        sel = order[:k]
-        ok = share[sel[-1]] > 0.5 and (len(order) == k or share[order[k]] < 0.5)
-        return sel, ok
+        ok = share[order[k - 1]] > 0.25 and (len(order) == k or share[order[k]] < 0.25)
+        return order[:k], bool(ok)
 
     # -- refinement of one bracket -----------------------------------------------------------
     def refine(self, a: float, b: float) -> tuple[float, str, float, Array, Array]:
@@ -247,21 +259,58 @@ class _Engine:
         return self._finish(b, vals, vecs, m, members, divergence)
 
     def _indicator(self, basis: Array, k: int, divergence: bool, target: float):
-        def fun(p: float) -> float:
+        """The exact indicator and, for affine families, its derivative (THEORY 5).
+
+        For the cluster ``C`` with eigenvalues ``v_j`` and eigenvalue derivatives
+        ``b_j = (W_C A1 V_C)_jj``: ``Delta = k sum v^2 - (sum v)^2`` with
+        ``Delta' = 2 k sum v_j b_j - 2 (sum v)(sum b_j)`` (symmetric functions of the cluster,
+        smooth through the defective double root); ``mean(v)`` for divergence; ``max Re v`` for
+        a Hopf crossing.
+        """
+
+        def fun(p: float, derivative: bool = False):
             vals, vecs, _ = self.decompose(p)
             sel, ok = self.select(vecs, basis, k)
             if not ok:
                 raise _Ambiguous
             v = vals[sel]
-            scale = np.abs(vals).max()
+            scale = np.abs(vals).max() if target else 1.0
             if self.undamped:
-                if divergence:
-                    return float(v.real.mean() / scale)
-                z = v / scale
-                return float((k * np.sum(z * z) - np.sum(z) ** 2).real)
-            return float(v.real.max() / scale) - target
+                f = v.real.mean() if divergence else (k * (v * v).sum() - v.sum() ** 2).real
+            else:
+                j = int(np.argmax(v.real))
+                f = v.real[j] - target * scale
+            if not derivative:
+                return float(f)
+            w = np.linalg.inv(vecs)[sel, :]
+            b = np.einsum("ij,jk,ki->i", w, self.ops[1], vecs[:, sel])
+            if self.undamped:
+                df = b.real.mean() if divergence else (2 * k * (v * b).sum() - 2 * v.sum() * b.sum()).real
+            else:
+                df = b.real[j]
+            return float(f), float(df)
 
         return fun
+
+    def _root(self, fun, a: float, b: float, fa: float, fb: float) -> float:
+        """Bracketed Newton iteration (secant start, bisection guard) to machine precision."""
+        lo, hi, flo = a, b, fa
+        p = a - fa * (b - a) / (fb - fa)
+        for _ in range(100):
+            f, df = fun(p, True)
+            if f == 0.0:
+                return p
+            if np.sign(f) == np.sign(flo):
+                lo, flo = p, f
+            else:
+                hi = p
+            new = p - f / df if df != 0.0 else np.inf
+            if not (min(lo, hi) < new < max(lo, hi)):
+                new = 0.5 * (lo + hi)
+            if abs(new - p) <= 4 * np.finfo(float).eps * abs(p) or new in (lo, hi):
+                return new
+            p = new
+        raise _Ambiguous
 
     def _solve(self, a: float, b: float, basis: Array, k: int, divergence: bool):
         target = 0.0
@@ -276,6 +325,8 @@ class _Engine:
             root = a
         elif np.sign(fa) == np.sign(fb):
             raise _Ambiguous
+        elif self.ops is not None and target == 0.0:
+            root = self._root(fun, a, b, fa, fb)
         else:
             root = optimize.brentq(fun, a, b, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=200)
         vals, vecs, m = self.decompose(root)
@@ -367,30 +418,34 @@ class _Engine:
         while start < len(grid):
             stop = min(start + chunk, len(grid))
             f, i = self.classify(grid[start:stop])
+            if start == 0 and f[0]:
+                return grid, f, brackets  # unstable already at p_min
             flags = np.concatenate([flags, f])
             ind = np.concatenate([ind, i])
             # examine transitions and bubbles up to the last point with both neighbours known
             limit = len(flags) - 1 if stop < len(grid) else len(flags)
-            for j in range(max(checked, 1), limit):
-                if flags[j] != flags[j - 1]:
-                    lo, hi = (grid[j - 1], grid[j])
-                    brackets.append((lo, hi) if not flags[j - 1] else (hi, lo))
-                elif (
-                    not flags[j]
-                    and j + 1 < len(flags)
-                    and not flags[j + 1]
-                    and ind[j] < ind[j - 1]
-                    and ind[j] <= ind[j + 1]
-                    and self.attracting(grid[j - 1], grid[j], grid[j + 1])
-                ):
-                    hit = self.bubble(grid[j - 1], grid[j + 1])
-                    if hit is not None:
-                        # stable at grid[j-1]; unstable at hit; stable again by grid[j+1]
-                        brackets.append((grid[j - 1], hit))
-                        if all_crossings:
-                            brackets.append((grid[j + 1], hit))
-                if brackets and not all_crossings:
-                    return grid, flags, brackets
+            lo_j = max(checked, 1)
+            if limit > lo_j:
+                js = np.arange(lo_j, limit)
+                change = flags[js] != flags[js - 1]
+                nxt = np.minimum(js + 1, len(flags) - 1)
+                dip = (
+                    ~flags[js] & (js + 1 < len(flags)) & ~flags[nxt]
+                    & (ind[js] < ind[js - 1]) & (ind[js] <= ind[nxt])
+                )
+                for j in js[change | dip]:
+                    if flags[j] != flags[j - 1]:
+                        lo, hi = grid[j - 1], grid[j]
+                        brackets.append((lo, hi) if not flags[j - 1] else (hi, lo))
+                    elif self.attracting(grid[j - 1], grid[j], grid[j + 1]):
+                        hit = self.bubble(grid[j - 1], grid[j + 1])
+                        if hit is not None:
+                            # stable at grid[j-1]; unstable at hit; stable again by grid[j+1]
+                            brackets.append((grid[j - 1], hit))
+                            if all_crossings:
+                                brackets.append((grid[j + 1], hit))
+                    if brackets and not all_crossings:
+                        return grid, flags, brackets
             checked = limit
             start = stop
         return grid, flags, brackets
@@ -415,12 +470,12 @@ def critical_load_family(
         raise ValueError(f"p_max = {p_max!r}: must be finite and above p_min = {p_min!r}")
     eng = _Engine(family, p_max, undamped=undamped)
     method = "coalescence" if eng.undamped else "hopf"
-    if eng.unstable_at(p_min):
+    grid, flags, brackets = eng.scan(p_min, p_max, n_scan, chunk, all_crossings)
+    if flags[0]:
         vals, vecs, m = eng.decompose(p_min)
         members, _, divergence = eng.unstable_cluster(vals)
         p, kind, omega, mode, part = eng._finish(p_min, vals, vecs, m, members, divergence)
         return CriticalLoad(p, kind, omega, p_max, method, mode, part, (), eng.evaluations)
-    grid, flags, brackets = eng.scan(p_min, p_max, n_scan, chunk, all_crossings)
     crossings = []
     first = None
     for a, b in brackets:

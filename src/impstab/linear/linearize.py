@@ -110,18 +110,17 @@ class ModelFamily:
         """
         args = (pk.mass6, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency,
                 pk.preload, 1.0)
+        # K(T) is linear in the classical form: take K1 from a large thrust so that K0 does not
+        # cancel it (the kernel's K is computed linearly in T, so the difference is exact to eps)
+        big = 1e8 * max(float(np.abs(pk.stiffness).max()), 1e-300) * pk.length_scale
+        m, d, g, k, _, _, _ = linearize_batch(np.array([0.0, big]), np.ones(2), *args, False, pk.length_scale)
         if lin == "equilibrium":
             load = np.concatenate([pk.e_dir, np.cross(pk.r_thrust, pk.e_dir)])
-            q0 = np.linalg.solve(_elastic(pk), load)
+            q0 = np.linalg.solve(k[0], load)
             rot = np.abs(q0[3:]).max() * pk.length_scale
             if rot > 1e-13 * max(np.abs(q0[:3]).max(), 1e-300):
                 return None
-        # K(T) is linear: take K1 from a large thrust so that K0 does not cancel it
-        t = np.array([0.0, 1.0])
-        m, d, g, k, _, _, _ = linearize_batch(t, np.ones(2), *args, False, pk.length_scale)
-        big = 1e8 * max(np.abs(k[0]).max(), 1e-300) / max(np.abs(k[1] - k[0]).max(), 1e-300)
-        kb = linearize_batch(np.array([big]), np.ones(1), *args, False, pk.length_scale)[3][0]
-        return m[0], d[0], k[0], (kb - k[0]) / big, g[0]
+        return m[0], d[0], k[0], (k[1] - k[0]) / big, g[0]
 
     def _affine_matrices(self, p: Array):
         m, d, k0, k1, g1 = self._affine  # type: ignore[attr-defined]
@@ -175,12 +174,6 @@ class ModelFamily:
             return self._affine_matrices(p)
         m, d, g, k, _, _ = self.evaluate(p)
         return m, d, g, k
-
-
-def _elastic(pk: PackedModel) -> Array:
-    from ..model.mounts import Mount, elastic_stiffness
-
-    return elastic_stiffness([Mount(r, k, c) for r, k, c in zip(pk.positions, pk.stiffness, pk.damping)])
 
 
 def linearize(model: Model, thrust: float, linearization: str | None = None) -> LinearSystem:
