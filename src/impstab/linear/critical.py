@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from scipy import optimize
 
 from .eigen import kinetic_shares, state_matrices
-from .families import LinearFamily, SystemFamily
+from .families import CallableFamily, LinearFamily, SystemFamily
 
 __all__ = ["CriticalLoad", "Crossing", "critical_load", "critical_load_family"]
 
@@ -496,8 +496,8 @@ def critical_load_family(
 
 def critical_load(
     M,
-    K0,
-    K1,
+    K0=None,
+    K1=None,
     D=None,
     G=None,
     p_max: float = 1.0,
@@ -505,12 +505,14 @@ def critical_load(
     n_scan: int = 64,
     all_crossings: bool = False,
 ) -> CriticalLoad:
-    """Critical load of ``M q'' + (D + G) q' + (K0 + p K1) q = 0``.
+    """Critical load of ``M q'' + (D + G) q' + (K0 + p K1) q = 0``, or of a callable system.
 
     Parameters
     ----------
     M, K0, K1 : (n, n) array_like
         Mass, stiffness at p = 0, and stiffness per unit load (non-symmetric for follower loads).
+        Alternatively ``M`` may be a callable ``p -> (M, D, G, K)`` (D or G may be None) for a
+        system that is not affine in the load; then K0 and K1 are not given.
     D, G : (n, n) array_like, optional
         Damping (symmetric) and gyroscopic (skew) matrices.
     p_max : float
@@ -534,5 +536,14 @@ def critical_load(
     >>> round(r.load, 10), r.kind
     (2.0857864376, 'flutter')
     """
-    fam = LinearFamily.build(M, K0, K1, D, G)
+    if callable(M):
+        if K0 is not None or K1 is not None:
+            raise ValueError("give either a callable system or the matrices M, K0, K1, not both")
+        first = M(0.0)
+        n = np.asarray(first[0]).shape[0]
+        fam = CallableFamily(M, n)
+    else:
+        if K0 is None or K1 is None:
+            raise ValueError("K0 and K1 are required with a mass matrix")
+        fam = LinearFamily.build(M, K0, K1, D, G)
     return critical_load_family(fam, p_max, n_scan=n_scan, all_crossings=all_crossings)
