@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from .so3 import _exp_so3, _jinv, _log_so3
+
 __all__ = [
     "skew",
     "rigid_map",
@@ -59,36 +61,12 @@ def rigid_map6(r: Array) -> Array:
 
 def rotation_from_vector(phi: Array) -> Array:
     """Rotation matrix ``exp(S(phi))`` (Rodrigues), accurate for small and large angles."""
-    phi = np.asarray(phi, dtype=float)
-    theta = float(np.linalg.norm(phi))
-    s = skew(phi)
-    if theta < 1e-4:
-        t2 = theta * theta
-        a = 1.0 - t2 / 6.0 + t2 * t2 / 120.0
-        b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
-    else:
-        a = np.sin(theta) / theta
-        b = (1.0 - np.cos(theta)) / (theta * theta)
-    return np.eye(3) + a * s + b * (s @ s)
+    return _exp_so3(np.ascontiguousarray(phi, dtype=float))
 
 
 def rotation_vector(rot: Array) -> Array:
     """Rotation vector ``phi`` with ``exp(S(phi)) = rot`` (angle below pi)."""
-    rot = np.asarray(rot, dtype=float)
-    c = np.clip(0.5 * (np.trace(rot) - 1.0), -1.0, 1.0)
-    theta = float(np.arccos(c))
-    w = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
-    if theta < 1e-4:
-        return w * (1.0 + theta * theta / 6.0)
-    return w * theta / np.sin(theta)
-
-
-def _jinv_coefficient(theta: float) -> float:
-    # c(theta) = 1/theta^2 - (1 + cos theta) / (2 theta sin theta)
-    if theta < 1e-3:
-        t2 = theta * theta
-        return 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
-    return 1.0 / theta**2 - (1.0 + np.cos(theta)) / (2.0 * theta * np.sin(theta))
+    return _log_so3(np.ascontiguousarray(rot, dtype=float))
 
 
 def inverse_left_jacobian(phi: Array) -> Array:
@@ -97,9 +75,7 @@ def inverse_left_jacobian(phi: Array) -> Array:
     If ``R = exp(S(phi))`` and ``R <- exp(S(dphi)) R``, then ``phi <- phi + J_l^{-1}(phi) dphi``
     to first order.
     """
-    phi = np.asarray(phi, dtype=float)
-    s = skew(phi)
-    return np.eye(3) - 0.5 * s + _jinv_coefficient(float(np.linalg.norm(phi))) * (s @ s)
+    return _jinv(np.ascontiguousarray(phi, dtype=float))
 
 
 def euler_zyx_to_matrix(phi: float, theta: float, psi: float) -> Array:

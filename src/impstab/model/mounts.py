@@ -88,19 +88,19 @@ def ring_positions(count: int, radius: float, x: float, start_angle_deg: float) 
     return np.column_stack([np.full(count, float(x)), radius * np.cos(ang), radius * np.sin(ang)])
 
 
-def elastic_stiffness(mounts: tuple[Mount, ...] | list[Mount]) -> Array:
-    """Condensed elastic stiffness about A, ``K_c = sum T6_i^T k_i T6_i`` (THEORY 3)."""
-    k = np.zeros((6, 6))
+def _condense(mounts, which: str) -> Array:
+    out = np.zeros((6, 6))
     for mt in mounts:
         t = rigid_map6(mt.position)
-        k += t.T @ mt.stiffness @ t
-    return k
+        out += t.T @ getattr(mt, which) @ t
+    return out
+
+
+def elastic_stiffness(mounts: tuple[Mount, ...] | list[Mount]) -> Array:
+    """Condensed elastic stiffness about A, ``K_c = sum T6_i^T k_i T6_i`` (THEORY 3)."""
+    return _condense(mounts, "stiffness")
 
 
 def mount_damping(mounts: tuple[Mount, ...] | list[Mount]) -> Array:
     """Condensed damping about A, ``D = sum T6_i^T c_i T6_i``."""
-    d = np.zeros((6, 6))
-    for mt in mounts:
-        t = rigid_map6(mt.position)
-        d += t.T @ mt.damping @ t
-    return d
+    return _condense(mounts, "damping")
