@@ -146,6 +146,15 @@ class _Engine:
         """Stability flags and the bubble indicator (closest gap / growth) at each load."""
         ops, _ = self.operators(p)
         self.evaluations += len(p)
+        lost = ~np.isfinite(ops).all(axis=(-2, -1))
+        if lost.any():
+            # no static equilibrium there: a static loss of stability (limit point)
+            ops = np.where(lost[:, None, None], np.eye(ops.shape[-1]), ops)
+            unstable, indicator = self._classify_ops(ops)
+            return unstable | lost, np.where(lost[:, None], -np.inf, indicator)
+        return self._classify_ops(ops)
+
+    def _classify_ops(self, ops: Array) -> tuple[Array, Array]:
         if self.undamped:
             s = np.linalg.eigvals(ops)
             scale = np.abs(s).max(axis=-1)
@@ -156,13 +165,18 @@ class _Engine:
             srt = np.sort(re, axis=-1)
             diffs = np.diff(srt, axis=-1)
             diffs[diffs < TOL_DUPLICATE] = np.inf
-            gap = diffs.min(axis=-1) if diffs.shape[-1] else np.full(len(p), np.inf)
-            indicator = np.where(cplx.any(axis=-1), -im.max(axis=-1), gap)
+            gap = diffs.min(axis=-1) if diffs.shape[-1] else np.full(len(ops), np.inf)
+            worst = -im.max(axis=-1)
+            # column 0: closest approach of two frequencies; column 1: smallest s (distance to
+            # divergence); both negative once unstable
+            indicator = np.stack(
+                [np.where(cplx.any(axis=-1), worst, gap), np.where(cplx.any(axis=-1), worst, srt[:, 0])], axis=-1
+            )
             return unstable, indicator
         lam = np.linalg.eigvals(ops)
         scale = np.abs(lam).max(axis=-1)
         growth = lam.real.max(axis=-1) / scale
-        return growth > TOL_UNSTABLE, -growth
+        return growth > TOL_UNSTABLE, np.stack([-growth, -growth], axis=-1)
 
     def unstable_at(self, p: float) -> bool:
         return bool(self.classify(np.array([p]))[0][0])
@@ -178,7 +192,11 @@ class _Engine:
                 ops, ms = self.operators(np.array([p]))
                 op, m = ops[0], ms[0]
             self.evaluations += 1
-            vals, vecs = np.linalg.eig(op)
+            if np.isfinite(op).all():
+                vals, vecs = np.linalg.eig(op)
+            else:  # no static equilibrium at this load
+                vals = np.full(op.shape[0], np.nan + 0j)
+                vecs = np.full(op.shape, np.nan + 0j)
             hit = self._cache[p] = (vals, vecs, m, op)
         return hit[:3]
 
@@ -236,6 +254,16 @@ class _Engine:
         """Root of the exact indicator between stable ``a`` and unstable ``b``."""
         for _ in range(200):
             vals_b, vecs_b, _ = self.decompose(b)
+            if not np.all(np.isfinite(vals_b)):
+                # no static equilibrium at b: close in on the limit point
+                mid = 0.5 * (a + b)
+                if mid in (a, b):
+                    return self._limit_point(a, b)
+                if self.unstable_at(mid):
+                    b = mid
+                else:
+                    a = mid
+                continue
             members, unique, divergence = self.unstable_cluster(vals_b)
             basis = self.projector(vecs_b, members)
             k = len(members)
@@ -257,6 +285,49 @@ class _Engine:
         vals, vecs, m = self.decompose(b)
         members, _, divergence = self.unstable_cluster(vals)
         return self._finish(b, vals, vecs, m, members, divergence)
+
+    def _limit_point(self, a: float, b: float):
+        """The static equilibrium path folds between ``a`` (reached) and ``b`` (not reached).
+
+        At a fold the smallest stiffness eigenvalue vanishes like ``sqrt(T_f - T)``, so its
+        square is linear in T there: secant steps on ``s_min^2`` from the reached side locate
+        ``T_f`` (a static loss of stability, reported as divergence).
+        """
+
+        def s2(p: float) -> float:
+            m, _, _, k = self.family.matrices(np.array([p]))
+            if not np.isfinite(k).all():
+                return np.nan
+            s = np.linalg.eigvals(np.linalg.solve(m[0], k[0]))
+            return float(np.min(np.abs(s)) ** 2)
+
+        x0, x1 = a - 0.5 * (b - a), a
+        f0, f1 = s2(x0), s2(x1)
+        for _ in range(40):
+            if not (np.isfinite(f0) and np.isfinite(f1)) or f1 == f0:
+                break
+            x2 = x1 - f1 * (x1 - x0) / (f1 - f0)
+            if not x1 < x2 < b:
+                break
+            f2 = s2(x2)
+            if not np.isfinite(f2):  # past the fold: pull back
+                b = x2
+                x2 = 0.5 * (x1 + x2)
+                f2 = s2(x2)
+                if not np.isfinite(f2):
+                    break
+            x0, f0, x1, f1 = x1, f1, x2, f2
+            if abs(x1 - x0) <= 1e-12 * abs(x1):
+                break
+        vals, vecs, m = self.decompose(x1)
+        if not np.isfinite(vals).all():
+            x1 = b  # the path could not be followed close to the fold: report where it ended
+            return float(x1), "divergence", 0.0, np.zeros(self.n, complex), np.full(self.n, np.nan)
+        j = int(np.argmin(np.abs(vals)))
+        mode = vecs[: self.n, j]
+        mode = mode * np.conj(mode[np.argmax(np.abs(mode))])
+        mode = mode / max(np.abs(mode).max(), 1e-300)
+        return float(x1), "divergence", 0.0, mode, kinetic_shares(vecs[: self.n, [j]], m)
 
     def _indicator(self, basis: Array, k: int, divergence: bool, target: float):
         """The exact indicator and, for affine families, its derivative (THEORY 5).
@@ -391,14 +462,18 @@ class _Engine:
         norm = max(np.abs(rate).max(), 1e-300)
         return bool(np.any(inter.real < -1e-8 * norm**2))
 
-    def bubble(self, lo: float, hi: float) -> float | None:
-        """Closest approach in ``(lo, hi)``; the load of an instability found there, else None."""
+    def bubble(self, lo: float, hi: float, column: int = 0) -> float | None:
+        """Closest approach in ``(lo, hi)``; the load of an instability found there, else None.
+
+        ``column`` 0 minimises the closest gap between frequencies (a flutter bubble), 1 the
+        smallest ``s`` (a divergence interval).
+        """
 
         def fun(p: float) -> float:
             unstable, ind = self.classify(np.array([p]))
             if unstable[0]:
                 raise _Unstable(p)
-            return float(ind[0])
+            return float(ind[0, column])
 
         try:
             optimize.minimize_scalar(
@@ -411,7 +486,7 @@ class _Engine:
     def scan(self, p_min: float, p_max: float, n_scan: int, chunk: int, all_crossings: bool):
         grid = np.linspace(p_min, p_max, n_scan + 1)
         flags = np.zeros(0, dtype=bool)
-        ind = np.zeros(0)
+        ind = np.zeros((0, 2))
         brackets: list[tuple[float, float]] = []
         checked = 0  # grid index up to which bubbles were examined
         start = 0
@@ -429,16 +504,20 @@ class _Engine:
                 js = np.arange(lo_j, limit)
                 change = flags[js] != flags[js - 1]
                 nxt = np.minimum(js + 1, len(flags) - 1)
-                dip = (
-                    ~flags[js] & (js + 1 < len(flags)) & ~flags[nxt]
-                    & (ind[js] < ind[js - 1]) & (ind[js] <= ind[nxt])
-                )
-                for j in js[change | dip]:
+                inner = ~flags[js] & (js + 1 < len(flags)) & ~flags[nxt]
+                dips = [
+                    inner & (ind[js, c] < ind[js - 1, c]) & (ind[js, c] <= ind[nxt, c]) for c in (0, 1)
+                ]
+                for j in js[change | dips[0] | dips[1]]:
                     if flags[j] != flags[j - 1]:
                         lo, hi = grid[j - 1], grid[j]
                         brackets.append((lo, hi) if not flags[j - 1] else (hi, lo))
-                    elif self.attracting(grid[j - 1], grid[j], grid[j + 1]):
-                        hit = self.bubble(grid[j - 1], grid[j + 1])
+                    else:
+                        hit = None
+                        if dips[1][j - lo_j] and self.undamped:
+                            hit = self.bubble(grid[j - 1], grid[j + 1], column=1)
+                        if hit is None and dips[0][j - lo_j] and self.attracting(grid[j - 1], grid[j], grid[j + 1]):
+                            hit = self.bubble(grid[j - 1], grid[j + 1], column=0)
                         if hit is not None:
                             # stable at grid[j-1]; unstable at hit; stable again by grid[j+1]
                             brackets.append((grid[j - 1], hit))

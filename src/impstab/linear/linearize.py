@@ -136,22 +136,53 @@ class ModelFamily:
     def packed(self) -> PackedModel:
         return self._packed  # type: ignore[attr-defined]
 
-    def evaluate(self, thrusts: Array):
-        """``M, D, G, K`` stacks and the static poses ``u0, R0`` at each thrust."""
+    def evaluate(self, thrusts: Array, strict: bool = True):
+        """``M, D, G, K`` stacks and the static poses ``u0, R0`` at each thrust.
+
+        Where no static equilibrium is found (a limit point: the mounts cannot carry the thrust)
+        ``strict`` raises :class:`~impstab.errors.NumericalError`; otherwise those entries are NaN.
+        """
         pk = self.packed
         thrusts = np.ascontiguousarray(np.atleast_1d(np.asarray(thrusts, dtype=float)))
+        t_start, u_start, r_start = self._start(float(np.abs(thrusts).min()))
         m, d, g, k, u0, r0, ok = linearize_batch(
             thrusts, pk.spins(thrusts), pk.mass6, pk.positions, pk.stiffness, pk.damping,
             pk.e_dir, pk.r_thrust, pk.tangency, pk.preload, pk.polar_inertia,
-            self.linearization == "equilibrium", pk.length_scale,
+            self.linearization == "equilibrium", pk.length_scale, t_start, u_start, r_start,
         )
+        self._remember(thrusts[ok], u0[ok], r0[ok])
         if not ok.all():
-            bad = thrusts[~ok][0]
-            raise NumericalError(
-                f"no static equilibrium found at thrust {bad:.6g} N (Newton with load stepping did "
-                "not converge): the mounts cannot carry this thrust"
-            )
+            if strict:
+                bad = thrusts[~ok][0]
+                raise NumericalError(
+                    f"no static equilibrium found at thrust {bad:.6g} N (Newton with load stepping "
+                    "did not converge): the mounts cannot carry this thrust"
+                )
+            for a in (m, d, g, k):
+                a[~ok] = np.nan
         return m, d, g, k, u0, r0
+
+    # -- continuation: every evaluation starts from the equilibrium at the nearest lower thrust
+    # already solved, so that past a bifurcation all evaluations follow one branch
+    def _start(self, thrust: float):
+        known = self.__dict__.get("_path")
+        if not known or self.linearization != "equilibrium":
+            return 0.0, np.zeros(3), np.eye(3)
+        below = [t for t in known if t <= thrust]
+        if not below:
+            return 0.0, np.zeros(3), np.eye(3)
+        t = max(below)
+        u, r = known[t]
+        return t, u.copy(), r.copy()
+
+    def _remember(self, thrusts: Array, u0: Array, r0: Array) -> None:
+        if self.linearization != "equilibrium" or not len(thrusts):
+            return
+        known = self.__dict__.setdefault("_path", {})
+        if len(known) > 4096:
+            known.clear()
+        for t, u, r in zip(thrusts, u0, r0):
+            known[float(abs(t))] = (u, r)
 
     @property
     def is_affine(self) -> bool:
@@ -172,7 +203,7 @@ class ModelFamily:
         p = np.atleast_1d(np.asarray(p, dtype=float))
         if self._affine is not None:  # type: ignore[attr-defined]
             return self._affine_matrices(p)
-        m, d, g, k, _, _ = self.evaluate(p)
+        m, d, g, k, _, _ = self.evaluate(p, strict=False)
         return m, d, g, k
 
 

@@ -24,7 +24,10 @@ from numba import njit
 
 from .so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _jinv_coeffs, _log_so3, _skew  # noqa: F401
 
-__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch"]
+__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "MAX_PREDICTOR"]
+
+#: largest accepted predictor step of the continuation (rad, or fraction of the length scale)
+MAX_PREDICTOR = 0.02
 
 
 @njit(cache=True)
@@ -83,24 +86,30 @@ def pose_forces(u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, 
 
 @njit(cache=True)
 def static_equilibrium_packed(
-    thrust, u0, rot0, positions, stiffness, damping, e_dir, r_thrust, tangency, length_scale
+    t_from, t_to, u0, rot0, positions, stiffness, damping, e_dir, r_thrust, tangency, length_scale
 ):
-    """Newton's method for the nonlinear statics ``Q(u, R) = 0`` from the start ``(u0, rot0)``.
+    """Follow the static equilibrium from ``(u0, rot0)`` at thrust ``t_from`` to ``t_to``.
 
-    Uses the full tangent (preload included) and load stepping when a full step fails.
-    Returns ``(u, rot, iterations, converged)``.
+    Newton's method with the full tangent (preload included) on load steps; a step is accepted
+    only if its tangent predictor is small (``MAX_PREDICTOR`` rad, or that fraction of the
+    length scale) and it lands near it (the Newton corrections after the first step are smaller
+    than half of it); otherwise the step is subdivided. A jump to a distant branch is
+    thereby refused: where no nearby equilibrium exists (a limit point) the result is not
+    converged. Returns ``(u, rot, iterations, converged)``.
     """
+    total = 0
     u = u0.copy()
     rot = rot0.copy()
-    total = 0
-    for n_sub in (1, 4, 16, 64):
+    for n_sub in (1, 4, 16, 64, 256, 1024):
         u = u0.copy()
         rot = rot0.copy()
         ok = True
         for k in range(1, n_sub + 1):
-            load = thrust * k / n_sub
+            load = t_from + (t_to - t_from) * k / n_sub
             converged = False
             small = 0
+            first = -1.0
+            later = 0.0
             for it in range(60):
                 qf, kel, kpre, kthr, _ = pose_forces(
                     u, rot, load, positions, stiffness, damping, e_dir, r_thrust, tangency
@@ -109,16 +118,20 @@ def static_equilibrium_packed(
                 total += 1
                 if not np.all(np.isfinite(step)):
                     break
+                size = max(np.max(np.abs(step[:3])) / length_scale, np.max(np.abs(step[3:])))
+                if first < 0.0:
+                    first = size
+                else:
+                    later += size
+                if first > MAX_PREDICTOR or later > 0.5 * first + 1e-10:
+                    break
                 u = u + step[:3]
                 rot = _exp_so3(step[3:]) @ rot
-                size = max(np.max(np.abs(step[:3])) / length_scale, np.max(np.abs(step[3:])))
                 if size < 1e-13:
                     small += 1
                     if small >= 2 or size < 1e-16:
                         converged = True
                         break
-                if size > 1.0:
-                    break
             if not converged:
                 ok = False
                 break
@@ -138,12 +151,13 @@ def _block_rotate(mat, rot):
 @njit(cache=True)
 def linearize_batch(
     thrusts, spins, mass6, positions, stiffness, damping, e_dir, r_thrust, tangency,
-    preload, polar_inertia, equilibrium, length_scale,
+    preload, polar_inertia, equilibrium, length_scale, t_start=0.0, u_start=None, r_start=None,
 ):
     """Linearized matrices ``M, D, G, K`` (stacks ``(N, 6, 6)``) at each thrust.
 
-    ``equilibrium=True``: at the nonlinear static equilibrium (warm-started along the sorted
-    thrusts); otherwise the classical form at the undeformed configuration with mount forces
+    ``equilibrium=True``: at the nonlinear static equilibrium, followed by continuation along
+    the sorted thrusts from the equilibrium ``(u_start, r_start)`` at ``t_start`` (default the
+    unloaded pose); a thrust the path cannot reach (past a limit point) is not converged; otherwise the classical form at the undeformed configuration with mount forces
     from linear statics. ``spins`` are the propeller speeds Omega (rad/s) at each thrust.
     Returns ``M, D, G, K, u0 (N, 3), R0 (N, 3, 3), converged (N,)``.
     """
@@ -166,25 +180,22 @@ def linearize_batch(
         t6[3:, 3:] = eye3
         k_c += t6.T @ stiffness[i] @ t6
     order = np.argsort(np.abs(thrusts))
-    u_prev = np.zeros(3)
-    r_prev = np.eye(3)
+    u_prev = np.zeros(3) if u_start is None else u_start.copy()
+    r_prev = np.eye(3) if r_start is None else r_start.copy()
+    t_prev = t_start
     for j in range(n):
         idx = order[j]
         thrust = thrusts[idx]
         if equilibrium:
             u, rot, _, conv = static_equilibrium_packed(
-                thrust, u_prev, r_prev, positions, stiffness, damping, e_dir, r_thrust, tangency,
-                length_scale,
+                t_prev, thrust, u_prev, r_prev, positions, stiffness, damping, e_dir, r_thrust,
+                tangency, length_scale,
             )
-            if not conv:
-                u, rot, _, conv = static_equilibrium_packed(
-                    thrust, np.zeros(3), np.eye(3), positions, stiffness, damping, e_dir, r_thrust,
-                    tangency, length_scale,
-                )
             ok_out[idx] = conv
             if conv:
                 u_prev = u
                 r_prev = rot
+                t_prev = thrust
             qf, kel, kpre, kthr, dm = pose_forces(
                 u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, tangency
             )
