@@ -458,7 +458,8 @@ class _Engine:
         upper = order[np.abs(re - re[j + 1]) < TOL_DUPLICATE * scale]
         rate = (a[2] - a[0]) / (hi - lo)
         b = np.linalg.solve(vecs, rate @ vecs)
-        inter = np.linalg.eigvals(b[np.ix_(lower, upper)] @ b[np.ix_(upper, lower)])
+        prod = b[np.ix_(lower, upper)] @ b[np.ix_(upper, lower)]
+        inter = prod.ravel() if prod.size == 1 else np.linalg.eigvals(prod)
         norm = max(np.abs(rate).max(), 1e-300)
         return bool(np.any(inter.real < -1e-8 * norm**2))
 

@@ -115,7 +115,8 @@ class ModelFamily:
         big = 1e8 * max(float(np.abs(pk.stiffness).max()), 1e-300) * pk.length_scale
         m, d, g, k, _, _, _ = linearize_batch(np.array([0.0, big]), np.ones(2), *args, False, pk.length_scale)
         if lin == "equilibrium":
-            load = np.concatenate([pk.e_dir, np.cross(pk.r_thrust, pk.e_dir)])
+            e, r = pk.e_dir, pk.r_thrust
+            load = np.array([e[0], e[1], e[2], r[1] * e[2] - r[2] * e[1], r[2] * e[0] - r[0] * e[2], r[0] * e[1] - r[1] * e[0]])
             q0 = np.linalg.solve(k[0], load)
             rot = np.abs(q0[3:]).max() * pk.length_scale
             if rot > 1e-13 * max(np.abs(q0[:3]).max(), 1e-300):
