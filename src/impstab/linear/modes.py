@@ -105,12 +105,30 @@ class ModalResult:
         )
 
 
+def _undamped_eigenpairs(system: LinearSystem):
+    """``lambda = i sqrt(s)`` from ``K x = s M x``: exact zero growth for real positive s.
+
+    A complex pair ``s, conj(s)`` (flutter) gives one growing and one decaying root at the same
+    frequency; a negative real s (divergence) gives ``lambda = +sqrt(-s)``.
+    """
+    s, x = np.linalg.eig(np.linalg.solve(system.M, system.K))
+    scale = max(np.abs(s).max(), 1e-300)
+    real = np.abs(s.imag) <= 1e-12 * scale
+    root = np.where(real, np.sqrt(np.abs(s.real)) + 0j, np.sqrt(s.astype(complex)))
+    lam = np.where(real & (s.real >= 0), 1j * root, np.where(real, root, 1j * root))
+    lam = np.where(~real & (lam.imag < 0), -lam, lam)
+    return lam, x
+
+
 def modes_of_system(system: LinearSystem) -> ModalResult:
     """Modes of a :class:`LinearSystem`."""
-    vals, vecs = np.linalg.eig(system.state_matrix())
-    scale = max(np.abs(vals).max(), 1e-300)
-    keep = (vals.imag > 1e-12 * scale) | (np.abs(vals.imag) <= 1e-12 * scale)
-    vals, vecs = vals[keep], vecs[:6, keep]
+    if not (np.any(system.D) or np.any(system.G)):
+        vals, vecs = _undamped_eigenpairs(system)
+    else:
+        vals, vecs = np.linalg.eig(system.state_matrix())
+        scale = max(np.abs(vals).max(), 1e-300)
+        keep = (vals.imag > 1e-12 * scale) | (np.abs(vals.imag) <= 1e-12 * scale)
+        vals, vecs = vals[keep], vecs[:6, keep]
     order = np.lexsort((vals.real, np.abs(vals.imag)))
     vals, vecs = vals[order], vecs[:, order]
     big = np.argmax(np.abs(vecs), axis=0)
