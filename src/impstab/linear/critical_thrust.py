@@ -16,6 +16,9 @@ __all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD"]
 
 #: share of kinetic energy above which a dof is listed among the modes involved
 PARTICIPATION_THRESHOLD = 0.05
+#: compressible fluid: relative change of the critical thrust that ends the frequency iteration
+FLUID_TOLERANCE = 1e-12
+FLUID_MAX_ITERATIONS = 20
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,6 +47,10 @@ class CriticalThrust:
     linearization : {"equilibrium", "classical"}
     crossings : tuple of Crossing
         All stability changes up to ``thrust_max`` (when requested).
+    fluid_frequency_hz, fluid_iterations, fluid_change
+        With compressible fluid loading: the frequency (Hz) at which the added mass and radiation
+        damping were taken (consistent with the onset frequency), the number of fixed-point
+        iterations, and the last relative change of the critical thrust.
     """
 
     thrust: float | None
@@ -60,6 +67,9 @@ class CriticalThrust:
     method: str
     crossings: tuple[Crossing, ...] = field(default_factory=tuple)
     model_name: str = ""
+    fluid_frequency_hz: float | None = None
+    fluid_iterations: int = 0
+    fluid_change: float | None = None
 
     @property
     def frequency_hz(self) -> float | None:
@@ -92,6 +102,9 @@ class CriticalThrust:
             "participation": None if self.participation is None else dict(zip(DOF_NAMES, map(float, self.participation))),
             "crossings": [c.__dict__ for c in self.crossings],
             "method": self.method,
+            "fluid_frequency_hz": self.fluid_frequency_hz,
+            "fluid_iterations": self.fluid_iterations,
+            "fluid_change": self.fluid_change,
             "model": self.model_name,
             "impstab_version": __version__,
         }
@@ -135,10 +148,26 @@ def critical_thrust(
     CriticalThrust
     """
     t_max = float(thrust_max if thrust_max is not None else model.analysis.thrust_max)
+    search = dict(n_scan=n_scan)
+    f_fluid, iterations, change = 0.0, 0, None
     fam = ModelFamily(model, linearization)
-    res: CriticalLoad = critical_load_family(fam, t_max, n_scan=n_scan, all_crossings=all_crossings)
-    if model.is_damped:
-        und = critical_load_family(ModelFamily(model, linearization, damped=False), t_max, n_scan=n_scan)
+    res: CriticalLoad = critical_load_family(fam, t_max, all_crossings=all_crossings, **search)
+    if model.fluid.compressible:
+        # radiation damping and added mass at the onset frequency, iterated to consistency
+        for iterations in range(1, FLUID_MAX_ITERATIONS + 1):
+            if res.load is None or not res.omega:
+                break
+            f_new = res.omega / (2 * np.pi)
+            fam = ModelFamily(model, linearization, fluid_frequency=f_new)
+            new = critical_load_family(fam, t_max, all_crossings=all_crossings, **search)
+            change = None if new.load is None else abs(new.load - res.load) / new.load
+            res, f_fluid = new, f_new
+            if change is not None and change <= FLUID_TOLERANCE:
+                break
+    if model.is_damped or (model.fluid.compressible and f_fluid > 0):
+        und = critical_load_family(
+            ModelFamily(model, linearization, damped=False, fluid_frequency=f_fluid), t_max, **search
+        )
     else:
         und = res
     return CriticalThrust(
@@ -156,4 +185,7 @@ def critical_thrust(
         method=res.method,
         crossings=res.crossings,
         model_name=model.name,
+        fluid_frequency_hz=f_fluid if model.fluid.compressible else None,
+        fluid_iterations=iterations,
+        fluid_change=change,
     )

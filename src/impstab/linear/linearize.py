@@ -27,6 +27,7 @@ class PackedModel:
     """A model flattened to arrays for the compiled kernels."""
 
     mass6: Array
+    damp6: Array
     positions: Array
     stiffness: Array
     damping: Array
@@ -48,8 +49,15 @@ class PackedModel:
         return np.full(thrusts.shape, self.speed)
 
 
-def pack_model(model: Model, damped: bool = True) -> PackedModel:
-    """Flatten ``model`` for the kernels (``damped=False`` drops every damper)."""
+def pack_model(model: Model, damped: bool = True, fluid_frequency: float = 0.0) -> PackedModel:
+    """Flatten ``model`` for the kernels.
+
+    ``damped=False`` drops every damper (mounts and fluid radiation); ``fluid_frequency`` (Hz)
+    selects the frequency of compressible fluid coefficients (added mass and radiation damping).
+    """
+    added, radiation = model.fluid.coefficients_at(fluid_frequency)
+    if not damped:
+        radiation = np.zeros((6, 6))
     positions = np.array([m.position for m in model.mounts], dtype=float).reshape(-1, 3)
     stiffness = np.array([m.stiffness for m in model.mounts], dtype=float).reshape(-1, 6, 6)
     damping = np.array([m.damping for m in model.mounts], dtype=float).reshape(-1, 6, 6)
@@ -57,7 +65,8 @@ def pack_model(model: Model, damped: bool = True) -> PackedModel:
         damping = np.zeros_like(damping)
     arms = np.concatenate([np.linalg.norm(positions, axis=1), [np.linalg.norm(model.thrust.point)]])
     return PackedModel(
-        mass6=np.ascontiguousarray(model.mass_matrix),
+        mass6=np.ascontiguousarray(model.body.mass_matrix() + added),
+        damp6=np.ascontiguousarray(radiation),
         positions=np.ascontiguousarray(positions),
         stiffness=np.ascontiguousarray(stiffness),
         damping=np.ascontiguousarray(damping),
@@ -84,18 +93,21 @@ class ModelFamily:
         Defaults to the model's ``analysis.linearization``.
     damped : bool
         False removes every damper (the undamped companion of a damped model).
+    fluid_frequency : float
+        Frequency (Hz) at which compressible fluid coefficients are taken (0: incompressible).
     """
 
     model: Model
     linearization: str | None = None
     damped: bool = True
+    fluid_frequency: float = 0.0
 
     def __post_init__(self) -> None:
         lin = self.linearization or self.model.analysis.linearization
         if lin not in LINEARIZATIONS:
             raise ModelError("analysis.linearization", lin, f"must be one of {list(LINEARIZATIONS)}")
         object.__setattr__(self, "linearization", lin)
-        pk = pack_model(self.model, damped=self.damped)
+        pk = pack_model(self.model, damped=self.damped, fluid_frequency=self.fluid_frequency)
         object.__setattr__(self, "_packed", pk)
         object.__setattr__(self, "_affine", self._affine_form(pk, lin))
 
@@ -108,7 +120,7 @@ class ModelFamily:
         then ``R0 = I`` solves the nonlinear statics exactly, the mount forces are the linear
         ones and the tangent equals the classical matrices.
         """
-        args = (pk.mass6, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency,
+        args = (pk.mass6, pk.damp6, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency,
                 pk.preload, 1.0)
         # K(T) is linear in the classical form: take K1 from a large thrust so that K0 does not
         # cancel it (the kernel's K is computed linearly in T, so the difference is exact to eps)
@@ -147,7 +159,7 @@ class ModelFamily:
         thrusts = np.ascontiguousarray(np.atleast_1d(np.asarray(thrusts, dtype=float)))
         t_start, u_start, r_start = self._start(float(np.abs(thrusts).min()))
         m, d, g, k, u0, r0, ok = linearize_batch(
-            thrusts, pk.spins(thrusts), pk.mass6, pk.positions, pk.stiffness, pk.damping,
+            thrusts, pk.spins(thrusts), pk.mass6, pk.damp6, pk.positions, pk.stiffness, pk.damping,
             pk.e_dir, pk.r_thrust, pk.tangency, pk.preload, pk.polar_inertia,
             self.linearization == "equilibrium", pk.length_scale, t_start, u_start, r_start,
         )

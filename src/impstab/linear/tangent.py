@@ -150,7 +150,7 @@ def _block_rotate(mat, rot):
 
 @njit(cache=True)
 def linearize_batch(
-    thrusts, spins, mass6, positions, stiffness, damping, e_dir, r_thrust, tangency,
+    thrusts, spins, mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency,
     preload, polar_inertia, equilibrium, length_scale, t_start=0.0, u_start=None, r_start=None,
 ):
     """Linearized matrices ``M, D, G, K`` (stacks ``(N, 6, 6)``) at each thrust.
@@ -158,7 +158,9 @@ def linearize_batch(
     ``equilibrium=True``: at the nonlinear static equilibrium, followed by continuation along
     the sorted thrusts from the equilibrium ``(u_start, r_start)`` at ``t_start`` (default the
     unloaded pose); a thrust the path cannot reach (past a limit point) is not converged; otherwise the classical form at the undeformed configuration with mount forces
-    from linear statics. ``spins`` are the propeller speeds Omega (rad/s) at each thrust.
+    from linear statics. ``spins`` are the propeller speeds Omega (rad/s) at each thrust;
+    ``mass6`` (rigid body plus added mass) and ``damp6`` (fluid radiation damping) are body-frame
+    matrices about A, rotated with the body.
     Returns ``M, D, G, K, u0 (N, 3), R0 (N, 3, 3), converged (N,)``.
     """
     n = thrusts.shape[0]
@@ -228,7 +230,7 @@ def linearize_batch(
         if preload:
             k = k + kpre
         m_out[idx] = _block_rotate(mass6, rot)
-        d_out[idx] = dm
+        d_out[idx] = dm + _block_rotate(damp6, rot)
         h = polar_inertia * spins[idx] * (rot @ e_dir)
         g_out[idx, 3:, 3:] = -_skew(h)
         k_out[idx] = k

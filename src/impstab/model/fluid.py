@@ -65,6 +65,7 @@ class FluidLoading:
     density: float | None = None
     sound_speed: float | None = None
     added_mass: Array = None  # type: ignore[assignment]
+    hull: Hull | None = None
 
     def __post_init__(self) -> None:
         a = np.zeros((6, 6)) if self.added_mass is None else np.array(self.added_mass, dtype=float)
@@ -87,4 +88,27 @@ class FluidLoading:
         else:  # pragma: no cover - guarded by the schema
             raise ValueError(f"fluid.model {model!r} is not hull-based")
         mat = segment_added_mass_matrix(coeffs.added_mass, coeffs.added_inertia, hull.center)
-        return cls(model=model, density=density, sound_speed=sound_speed, added_mass=mat)
+        return cls(model=model, density=density, sound_speed=sound_speed, added_mass=mat, hull=hull)
+
+    @property
+    def compressible(self) -> bool:
+        """True when the coefficients depend on frequency (baffled cylinder with a sound speed)."""
+        return self.model == "baffled-cylinder" and self.sound_speed is not None
+
+    def coefficients_at(self, frequency_hz: float = 0.0) -> tuple[Array, Array]:
+        """Added mass and radiation damping about A (body frame, 6 x 6) at ``frequency_hz``.
+
+        Frequency-independent models return the zero-frequency added mass and no damping.
+        """
+        if not self.compressible or frequency_hz <= 0.0 or self.hull is None:
+            return self.added_mass, np.zeros((6, 6))
+        from .. import fluid as _fluid
+
+        h = self.hull
+        c = _fluid.baffled_cylinder(
+            radius=h.radius, length=h.length, density=self.density, sound_speed=self.sound_speed,
+            frequency=float(frequency_hz),
+        )
+        mass = segment_added_mass_matrix(c.added_mass, c.added_inertia, h.center)
+        damp = segment_added_mass_matrix(c.radiation_resistance or 0.0, c.rotational_radiation_resistance or 0.0, h.center)
+        return mass, damp
