@@ -39,8 +39,10 @@ Array = NDArray[np.float64]
 
 #: relative size of an imaginary part (of s) or a real part (of lambda) that counts as unstable
 TOL_UNSTABLE = 1e-7
-#: real part (relative) above which a branch counts as marginal (on the axis to rounding)
+#: real part (relative to the eigenvalue) below which a branch counts as marginal (on the axis)
 TOL_MARGINAL = 1e-11
+#: rounding floor, relative to the spectral radius
+FLOOR = 1e3 * np.finfo(float).eps
 #: relative distance within which eigenvalues belong to one cluster
 TOL_CLUSTER = 1e-6
 #: relative gap below which two real s are symmetric duplicates, not an approach
@@ -99,6 +101,12 @@ class CriticalLoad:
         return None if self.omega is None else self.omega / (2.0 * np.pi)
 
 
+def _relative_real(v: Array) -> Array:
+    """``Re(v) / |v|``, and 0 for an eigenvalue at the origin."""
+    mag = np.abs(v)
+    return np.where(mag > 0, v.real / np.where(mag > 0, mag, 1.0), 0.0)
+
+
 class _Unstable(Exception):
     def __init__(self, p: float) -> None:
         self.p = p
@@ -108,6 +116,7 @@ class _Engine:
     def __init__(self, family: SystemFamily, p_max: float, undamped: bool | None = None) -> None:
         self.family = family
         self.n = family.n
+        self.p_range = (0.0, float(p_max))
         self.evaluations = 0
         self._cache: dict[float, tuple] = {}
         # damping and gyroscopic terms may depend on the load (a propeller speed that follows it)
@@ -154,29 +163,43 @@ class _Engine:
             return unstable | lost, np.where(lost[:, None], -np.inf, indicator)
         return self._classify_ops(ops)
 
-    def _classify_ops(self, ops: Array) -> tuple[Array, Array]:
+    def unstable_parts(self, vals: Array) -> tuple[Array, Array]:
+        """Masks of unstable eigenvalues: (flutter-type, divergence-type), per eigenvalue.
+
+        Each eigenvalue is judged against its own magnitude (a stiff mode must not hide the
+        flutter of a soft one), with a rounding floor relative to the spectral radius.
+        """
+        mag = np.abs(vals)
+        floor = FLOOR * mag.max(axis=-1, keepdims=True)
         if self.undamped:
-            s = np.linalg.eigvals(ops)
-            scale = np.abs(s).max(axis=-1)
-            im = np.abs(s.imag) / scale[:, None]
-            re = s.real / scale[:, None]
-            cplx = im > TOL_UNSTABLE
-            unstable = cplx.any(axis=-1) | ((re < 0) & ~cplx).any(axis=-1)
+            cplx = np.abs(vals.imag) > np.maximum(TOL_UNSTABLE * mag, floor)
+            neg = (vals.real < -floor) & ~cplx
+            return cplx, neg
+        grow = vals.real > np.maximum(TOL_UNSTABLE * mag, floor)
+        real = np.abs(vals.imag) <= np.maximum(TOL_CLUSTER * mag, floor)
+        return grow & ~real, grow & real
+
+    def _classify_ops(self, ops: Array) -> tuple[Array, Array]:
+        vals = np.linalg.eigvals(ops)
+        cplx, neg = self.unstable_parts(vals)
+        unstable = (cplx | neg).any(axis=-1)
+        mag = np.maximum(np.abs(vals), 1e-300)
+        if self.undamped:
+            scale = mag.max(axis=-1)
+            re = vals.real / scale[:, None]
             srt = np.sort(re, axis=-1)
             diffs = np.diff(srt, axis=-1)
             diffs[diffs < TOL_DUPLICATE] = np.inf
             gap = diffs.min(axis=-1) if diffs.shape[-1] else np.full(len(ops), np.inf)
-            worst = -im.max(axis=-1)
+            worst = -(np.abs(vals.imag) / mag).max(axis=-1)
             # column 0: closest approach of two frequencies; column 1: smallest s (distance to
             # divergence); both negative once unstable
             indicator = np.stack(
                 [np.where(cplx.any(axis=-1), worst, gap), np.where(cplx.any(axis=-1), worst, srt[:, 0])], axis=-1
             )
             return unstable, indicator
-        lam = np.linalg.eigvals(ops)
-        scale = np.abs(lam).max(axis=-1)
-        growth = lam.real.max(axis=-1) / scale
-        return growth > TOL_UNSTABLE, np.stack([-growth, -growth], axis=-1)
+        growth = (vals.real / mag).max(axis=-1)
+        return unstable, np.stack([-growth, -growth], axis=-1)
 
     def unstable_at(self, p: float) -> bool:
         return bool(self.classify(np.array([p]))[0][0])
@@ -202,11 +225,9 @@ class _Engine:
 
     def unstable_cluster(self, vals: Array) -> tuple[Array, bool, bool]:
         """Indices of the cluster that is unstable, whether it is unique, and if divergent."""
-        scale = np.abs(vals).max()
+        cplx, neg = self.unstable_parts(vals)
+        bad = np.flatnonzero(cplx | neg)
         if self.undamped:
-            cplx = np.abs(vals.imag) > TOL_UNSTABLE * scale
-            neg = (vals.real < 0) & ~cplx
-            bad = np.flatnonzero(cplx | neg)
             if cplx.any():
                 j0 = np.flatnonzero(cplx)[np.argmin(vals.real[cplx])]
                 divergence = False
@@ -214,13 +235,11 @@ class _Engine:
                 j0 = bad[np.argmin(vals.real[bad])]
                 divergence = True
         else:
-            bad = np.flatnonzero(vals.real > TOL_UNSTABLE * scale)
-            j0 = bad[np.argmax(vals.real[bad])]
-            divergence = abs(vals[j0].imag) <= TOL_CLUSTER * scale
+            j0 = bad[np.argmax(_relative_real(vals[bad]))]
+            divergence = bool(neg[j0])
         ref = vals[j0]
-        close = (np.abs(vals - ref) <= TOL_CLUSTER * scale) | (
-            np.abs(vals - np.conj(ref)) <= TOL_CLUSTER * scale
-        )
+        tol = max(TOL_CLUSTER * abs(ref), FLOOR * np.abs(vals).max())
+        close = (np.abs(vals - ref) <= tol) | (np.abs(vals - np.conj(ref)) <= tol)
         members = np.flatnonzero(close)
         unique = set(bad.tolist()) <= set(members.tolist())
         return members, unique, divergence
@@ -251,7 +270,13 @@ class _Engine:
 
     # -- refinement of one bracket -----------------------------------------------------------
     def refine(self, a: float, b: float) -> tuple[float, str, float, Array, Array]:
-        """Root of the exact indicator between stable ``a`` and unstable ``b``."""
+        """Root of the exact indicator between stable ``a`` and unstable ``b``.
+
+        The classification thresholds only bracket: if the exact indicator shows that ``a`` is
+        already past the onset (a point inside the threshold window), ``a`` steps back, away
+        from ``b``, until it is truly stable.
+        """
+        lo_lim, hi_lim = self.p_range
         for _ in range(200):
             vals_b, vecs_b, _ = self.decompose(b)
             if not np.all(np.isfinite(vals_b)):
@@ -272,6 +297,13 @@ class _Engine:
             if unique and ok_a:
                 try:
                     return self._solve(a, b, basis, k, divergence)
+                except _NoSignChange:
+                    step = a - b
+                    new_a = min(max(a + step, lo_lim), hi_lim)
+                    if new_a == a:
+                        break
+                    a = new_a
+                    continue
                 except _Ambiguous:
                     pass
             mid = 0.5 * (a + b)
@@ -345,12 +377,11 @@ class _Engine:
             if not ok:
                 raise _Ambiguous
             v = vals[sel]
-            scale = np.abs(vals).max() if target else 1.0
             if self.undamped:
                 f = v.real.mean() if divergence else (k * (v * v).sum() - v.sum() ** 2).real
             else:
-                j = int(np.argmax(v.real))
-                f = v.real[j] - target * scale
+                j = int(np.argmax(_relative_real(v)))
+                f = v.real[j] - target * abs(v[j])
             if not derivative:
                 return float(f)
             w = np.linalg.inv(vecs)[sel, :]
@@ -362,6 +393,19 @@ class _Engine:
             return float(f), float(df)
 
         return fun
+
+    def _marginal(self, a: float, b: float, basis, k: int) -> bool:
+        """Whether the crossing branch lay on the imaginary axis before ``a`` (two points)."""
+        lo_lim, hi_lim = self.p_range
+        for p in (a, min(max(a + (a - b), lo_lim), hi_lim)):
+            vals, vecs, _ = self.decompose(p)
+            sel, ok = self.select(vecs, basis, k)
+            if not ok:
+                return False
+            v = vals[sel]
+            if np.max(np.abs(_relative_real(v))) > TOL_MARGINAL:
+                return False
+        return True
 
     def _root(self, fun, a: float, b: float, fa: float, fb: float) -> float:
         """Bracketed Newton iteration (secant start, bisection guard) to machine precision."""
@@ -385,17 +429,16 @@ class _Engine:
 
     def _solve(self, a: float, b: float, basis: Array, k: int, divergence: bool):
         target = 0.0
-        if not self.undamped:
-            fa = self._indicator(basis, k, divergence, 0.0)(a)
-            if not self.damped or fa > -TOL_MARGINAL:
-                # the branch was marginal (on the imaginary axis to rounding) before it left it
-                target = TOL_UNSTABLE
+        if not self.undamped and self._marginal(a, b, basis, k):
+            # the branch was on the imaginary axis (to rounding) before it left it: it leaves
+            # like sqrt(p - p_c), and the onset is where it is off the axis by TOL_UNSTABLE
+            target = TOL_UNSTABLE
         fun = self._indicator(basis, k, divergence, target)
         fa, fb = fun(a), fun(b)
         if fa == 0.0:
             root = a
         elif np.sign(fa) == np.sign(fb):
-            raise _Ambiguous
+            raise _NoSignChange
         elif self.ops is not None and target == 0.0:
             root = self._root(fun, a, b, fa, fb)
         else:
@@ -535,6 +578,10 @@ class _Ambiguous(Exception):
     pass
 
 
+class _NoSignChange(Exception):
+    pass
+
+
 def critical_load_family(
     family: SystemFamily,
     p_max: float,
@@ -549,6 +596,7 @@ def critical_load_family(
     if not (np.isfinite(p_max) and p_max > p_min):
         raise ValueError(f"p_max = {p_max!r}: must be finite and above p_min = {p_min!r}")
     eng = _Engine(family, p_max, undamped=undamped)
+    eng.p_range = (float(p_min), float(p_max))
     method = "coalescence" if eng.undamped else "hopf"
     grid, flags, brackets = eng.scan(p_min, p_max, n_scan, chunk, all_crossings)
     if flags[0]:
