@@ -218,7 +218,12 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
     t.add_row("search range", f"0 to {res.thrust_max:g} N")
     for c in res.crossings:
         t.add_row(f"crossing ({c.direction})", f"{c.load:.10g} N, {c.kind}, {c.omega / (2 * np.pi):.6g} Hz")
-    _console().print(t)
+    if res.fluid_frequency_hz is not None:
+        t.add_row("fluid coefficients at", f"{res.fluid_frequency_hz:.6g} Hz ({res.fluid_iterations} iterations, last change {res.fluid_change if res.fluid_change is not None else float('nan'):.2e})")
+    con = _console()
+    con.print(t)
+    for w in res.warnings:
+        con.print(f"[yellow]warning:[/yellow] {w}")
 
 
 commands = [check_cmd, modes_cmd, locus_cmd, critical_cmd]

@@ -84,6 +84,9 @@ class CriticalLoad:
         Every stability change up to ``p_max`` (only when requested with ``all_crossings``).
     evaluations : int
         Number of eigenproblems solved.
+    warnings : tuple of str
+        Numerical trouble met on the way (e.g. an onset located only to the classification
+        tolerance), never hidden.
     """
 
     load: float | None
@@ -95,10 +98,25 @@ class CriticalLoad:
     participation: Array | None = None
     crossings: tuple[Crossing, ...] = field(default_factory=tuple)
     evaluations: int = 0
+    warnings: tuple[str, ...] = field(default_factory=tuple)
 
     @property
     def frequency_hz(self) -> float | None:
         return None if self.omega is None else self.omega / (2.0 * np.pi)
+
+
+def _pair_growth(v: Array) -> float:
+    """Largest real part of a cluster (upper half plane), from its symmetric functions.
+
+    For the upper-half members (a pair lambda_1, lambda_2, possibly each doubled by symmetry)
+    ``c = mean`` and ``d = mean((lambda - c)^2) = ((lambda_1 - lambda_2) / 2)^2`` are analytic in
+    the load even where the pair is defective, so ``Re c + |Re sqrt(d)|`` keeps its accuracy
+    there; for a single eigenvalue it is just ``Re lambda``.
+    """
+    up = v[v.imag >= 0] if np.any(v.imag > 0) else v
+    c = up.mean()
+    d = ((up - c) ** 2).mean()
+    return float(c.real + abs(np.sqrt(d + 0j).real))
 
 
 def _relative_real(v: Array) -> Array:
@@ -118,6 +136,7 @@ class _Engine:
         self.n = family.n
         self.p_range = (0.0, float(p_max))
         self.evaluations = 0
+        self.warnings: list[str] = []
         self._cache: dict[float, tuple] = {}
         # damping and gyroscopic terms may depend on the load (a propeller speed that follows it)
         _, d, g, _ = family.matrices(np.array([0.0, 0.5 * p_max, p_max]))
@@ -240,6 +259,10 @@ class _Engine:
         ref = vals[j0]
         tol = max(TOL_CLUSTER * abs(ref), FLOOR * np.abs(vals).max())
         close = (np.abs(vals - ref) <= tol) | (np.abs(vals - np.conj(ref)) <= tol)
+        if not self.undamped and not divergence:
+            # the decaying partner of a merged pair has the same frequency: keep it in the
+            # cluster (before the merge the two modes span both branches)
+            close |= np.abs(np.abs(vals.imag) - abs(ref.imag)) <= tol
         members = np.flatnonzero(close)
         unique = set(bad.tolist()) <= set(members.tolist())
         return members, unique, divergence
@@ -313,7 +336,13 @@ class _Engine:
                 b = mid
             else:
                 a = mid
-        # the bracket is as narrow as floating point allows
+        # the exact indicator could not be used: the bracket was narrowed on the stability
+        # classification only, which resolves the onset to its tolerance, not to rounding
+        self.warnings.append(
+            f"onset near {b:.10g} located by bisection on the stability tolerance "
+            f"(growth above {TOL_UNSTABLE:g} of |lambda|), not by the exact indicator: expect a "
+            "relative accuracy near that tolerance (very light damping?)"
+        )
         vals, vecs, m = self.decompose(b)
         members, _, divergence = self.unstable_cluster(vals)
         return self._finish(b, vals, vecs, m, members, divergence)
@@ -381,7 +410,7 @@ class _Engine:
                 f = v.real.mean() if divergence else (k * (v * v).sum() - v.sum() ** 2).real
             else:
                 j = int(np.argmax(_relative_real(v)))
-                f = v.real[j] - target * abs(v[j])
+                f = _pair_growth(v) - target * abs(v[j])
             if not derivative:
                 return float(f)
             w = np.linalg.inv(vecs)[sel, :]
@@ -439,7 +468,7 @@ class _Engine:
             root = a
         elif np.sign(fa) == np.sign(fb):
             raise _NoSignChange
-        elif self.ops is not None and target == 0.0:
+        elif self.ops is not None and target == 0.0 and (self.undamped or k <= 2):
             root = self._root(fun, a, b, fa, fb)
         else:
             root = optimize.brentq(fun, a, b, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=200)
@@ -614,11 +643,13 @@ def critical_load_family(
             first = (p, kind, omega, mode, part)
     crossings.sort(key=lambda c: c.load)
     if first is None:
-        return CriticalLoad(None, "none", None, p_max, method, None, None, tuple(crossings), eng.evaluations)
+        return CriticalLoad(
+            None, "none", None, p_max, method, None, None, tuple(crossings), eng.evaluations, tuple(eng.warnings)
+        )
     p, kind, omega, mode, part = first
     return CriticalLoad(
         p, kind, omega, p_max, method, mode, part,
-        tuple(crossings) if all_crossings else (), eng.evaluations,
+        tuple(crossings) if all_crossings else (), eng.evaluations, tuple(eng.warnings),
     )
 
 

@@ -17,7 +17,7 @@ __all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD"]
 #: share of kinetic energy above which a dof is listed among the modes involved
 PARTICIPATION_THRESHOLD = 0.05
 #: compressible fluid: relative change of the critical thrust that ends the frequency iteration
-FLUID_TOLERANCE = 1e-12
+FLUID_TOLERANCE = 1e-8
 FLUID_MAX_ITERATIONS = 20
 
 
@@ -70,6 +70,7 @@ class CriticalThrust:
     fluid_frequency_hz: float | None = None
     fluid_iterations: int = 0
     fluid_change: float | None = None
+    warnings: tuple[str, ...] = ()
 
     @property
     def frequency_hz(self) -> float | None:
@@ -105,6 +106,7 @@ class CriticalThrust:
             "fluid_frequency_hz": self.fluid_frequency_hz,
             "fluid_iterations": self.fluid_iterations,
             "fluid_change": self.fluid_change,
+            "warnings": list(self.warnings),
             "model": self.model_name,
             "impstab_version": __version__,
         }
@@ -188,4 +190,5 @@ def critical_thrust(
         fluid_frequency_hz=f_fluid if model.fluid.compressible else None,
         fluid_iterations=iterations,
         fluid_change=change,
+        warnings=tuple(res.warnings) + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
     )
