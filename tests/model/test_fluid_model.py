@@ -85,3 +85,19 @@ def test_check_prints_coefficients(capsys, tmp_path):
     out = capsys.readouterr().out
     assert code == 0
     assert "x strip theory" in out and "added mass" in out
+
+
+def test_modes_take_fluid_coefficients_at_their_own_frequency():
+    model = model_from_dict(fluid_dict(sound_speed=1500.0))
+    res = impstab.modes(model, 3000.0)
+    from impstab.linear.linearize import ModelFamily
+
+    for j in (0, 2):
+        f = res.frequency_hz[j]
+        fam = ModelFamily(model, fluid_frequency=f)
+        m, d, g, k, u0, r0 = fam.evaluate(np.array([3000.0]))
+        from impstab.linear.eigen import state_matrices
+
+        lam = np.linalg.eigvals(state_matrices(m[0], d[0] + g[0], k[0]))
+        assert np.min(np.abs(lam - res.eigenvalues[j])) < 1e-9 * abs(res.eigenvalues[j])
+        assert res.growth_rate[j] < 0    # radiation damps every transverse mode

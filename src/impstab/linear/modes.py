@@ -129,6 +129,7 @@ def modes_of_system(system: LinearSystem) -> ModalResult:
         scale = max(np.abs(vals).max(), 1e-300)
         keep = (vals.imag > 1e-12 * scale) | (np.abs(vals.imag) <= 1e-12 * scale)
         vals, vecs = vals[keep], vecs[:6, keep]
+    vals, vecs = np.asarray(vals, dtype=complex), np.asarray(vecs, dtype=complex)
     order = np.lexsort((vals.real, np.abs(vals.imag)))
     vals, vecs = vals[order], vecs[:, order]
     big = np.argmax(np.abs(vecs), axis=0)
@@ -139,5 +140,31 @@ def modes_of_system(system: LinearSystem) -> ModalResult:
 
 
 def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -> ModalResult:
-    """Natural frequencies, damping ratios, growth rates and mode shapes at thrust ``thrust`` (N)."""
-    return modes_of_system(linearize(model, thrust, linearization))
+    """Natural frequencies, damping ratios, growth rates and mode shapes at thrust ``thrust`` (N).
+
+    With compressible fluid loading each mode is computed with the added mass and radiation
+    damping at its own frequency, iterated to consistency (fixed point on the frequency).
+    """
+    base = modes_of_system(linearize(model, thrust, linearization))
+    if not model.fluid.compressible:
+        return base
+    return _fluid_consistent(model, thrust, linearization, base)
+
+
+def _fluid_consistent(model: Model, thrust: float, linearization: str | None, base: ModalResult) -> ModalResult:
+    from .linearize import ModelFamily
+
+    vals, shapes, part = base.eigenvalues.copy(), base.shapes.copy(), base.participation.copy()
+    for j in range(len(vals)):
+        f = abs(vals[j].imag) / (2 * np.pi)
+        for _ in range(50):
+            fam = ModelFamily(model, linearization, fluid_frequency=f)
+            m, d, g, k, u0, r0 = fam.evaluate(np.array([thrust]))
+            res = modes_of_system(LinearSystem(m[0], d[0], g[0], k[0], thrust, fam.linearization, u0[0], r0[0]))
+            i = int(np.argmin(np.abs(res.eigenvalues - vals[j])))
+            vals[j], shapes[:, j], part[j] = res.eigenvalues[i], res.shapes[:, i], res.participation[i]
+            f_new = abs(vals[j].imag) / (2 * np.pi)
+            if abs(f_new - f) <= 1e-12 * max(f_new, 1e-300):
+                break
+            f = f_new
+    return ModalResult(base.thrust, base.linearization, vals, shapes, part)
