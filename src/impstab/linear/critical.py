@@ -138,14 +138,17 @@ class _Engine:
         self.evaluations = 0
         self.warnings: list[str] = []
         self._cache: dict[float, tuple] = {}
-        # damping and gyroscopic terms may depend on the load (a propeller speed that follows it)
-        _, d, g, _ = family.matrices(np.array([0.0, 0.5 * p_max, p_max]))
+        # affine families (constant M, D, G; K = K0 + p K1): the operator is op0 + p op1
+        parts = family.affine_parts() if hasattr(family, "affine_parts") else None
+        if parts is not None:
+            d, g = parts[1], parts[2]
+        else:
+            # damping and gyroscopic terms may depend on the load (a propeller speed following it)
+            _, d, g, _ = family.matrices(np.array([0.0, 0.5 * p_max, p_max]))
         self.damped = bool(np.any(d != 0))
         if undamped is None:
             undamped = not (self.damped or np.any(g != 0))
         self.undamped = undamped
-        # affine families (constant M, D, G; K = K0 + p K1): the operator is op0 + p op1
-        parts = family.affine_parts() if hasattr(family, "affine_parts") else None
         self.ops = None
         if parts is not None:
             m, d, g, k0, k1 = parts
@@ -617,7 +620,7 @@ def critical_load_family(
     *,
     p_min: float = 0.0,
     n_scan: int = 64,
-    chunk: int = 32,
+    chunk: int = 65,
     all_crossings: bool = False,
     undamped: bool | None = None,
 ) -> CriticalLoad:
