@@ -35,7 +35,8 @@ def _thrust_list(thrust: float | None, thrusts: str | None) -> list[float]:
         try:
             values = [float(v) for v in thrusts.split(",") if v.strip()]
         except ValueError:
-            raise ModelError("--thrusts", thrusts, "must be numbers separated by commas, e.g. 10000,18012,20000") from None
+            raise ModelError("--thrusts", thrusts,
+                             "must be numbers separated by commas, e.g. 10000,18012,20000") from None
         if not values:
             raise ModelError("--thrusts", thrusts, "must list at least one thrust")
         for v in values:
@@ -128,7 +129,8 @@ def _table(results, model_name: str):
 @click.command("simulate")
 @click.argument("model_file", type=click.Path(dir_okay=False))
 @click.option("--thrust", type=float, default=None, help="constant thrust T (N)")
-@click.option("--thrusts", default=None, help="several thrusts T1,T2,... (N), one figure (e.g. sub-, at and supercritical)")
+@click.option("--thrusts", default=None,
+              help="several thrusts T1,T2,... (N), one figure (e.g. sub-, at and supercritical)")
 @click.option("--duration", type=float, required=True, help="simulated time (s)")
 @click.option("--integrator", type=INTEGRATOR, default="hamming", show_default=True)
 @click.option("--dt", type=float, default=None, help="fixed step (s); default 40 steps per period of the fastest mode")
@@ -182,7 +184,8 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     png = out.with_suffix(".png")
     _save_png(results, png)
     if as_json:
-        print_json({"runs": [r.to_dict() for r in results], "critical_thrust": crit, "output": str(out), "figure": str(png)})
+        print_json({"runs": [r.to_dict() for r in results], "critical_thrust": crit, "output": str(out),
+                    "figure": str(png)})
         return
     from rich.console import Console
 

@@ -1,0 +1,224 @@
+"""Result of a time simulation: sampled time histories and what produced them."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.model import DOF_NAMES
+from .growth import GrowthFit
+
+__all__ = ["SimulationResult", "combine_results", "results_to_dataframe"]
+
+Array = NDArray[np.float64]
+
+_VELOCITY_NAMES = ("u", "v", "w", "p", "q", "r")
+_SCALARS = ("model_name", "integrator", "dt", "final_dt", "sample", "duration", "thrust_history", "completed",
+            "stop_reason", "stop_time", "steps", "rhs_evaluations", "restarts", "wall_time", "fastest_omega",
+            "fastest_mode", "step_limit", "length_scale", "critical_thrust", "classification")
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationResult:
+    """Time histories of a nonlinear run from the static equilibrium.
+
+    Attributes
+    ----------
+    time : (k,) sample times (s)
+    deviation : (k, 12) state minus the equilibrium: displacement of A (m, hull frame), Euler
+        angles (rad), body-frame velocity (m/s) and angular velocity (rad/s)
+    equilibrium : (12,) the static equilibrium ``(X_A, Xi, 0)`` at ``T(0)``
+    thrust : (k,) thrust at the samples (N)
+    mount_loads : (k, n_mounts, 6) force of each mount on the body (N, hull frame) and its moment
+        (N m; non-zero for mounts with rotational stiffness only)
+    error_estimate : (k,) or None
+        Hamming's relative local error estimate, largest over each sampling interval.
+    completed : bool
+        False when the run stopped early; ``stop_reason`` and ``stop_time`` (s) say why and when.
+    growth : GrowthFit
+        Envelope growth rate fitted from the run and ``max Re(lambda)`` at the same thrust.
+    classification : {"subcritical", "critical", "supercritical", "unknown", "not computed"}
+    """
+
+    time: Array
+    deviation: Array
+    equilibrium: Array
+    thrust: Array
+    mount_loads: Array
+    error_estimate: Array | None
+    model_name: str
+    integrator: str
+    dt: float
+    final_dt: float
+    sample: float
+    duration: float
+    thrust_history: str
+    perturbation: dict
+    completed: bool
+    stop_reason: str | None
+    stop_time: float | None
+    steps: int
+    rhs_evaluations: int
+    restarts: int
+    wall_time: float
+    fastest_omega: float
+    fastest_mode: str
+    step_limit: float
+    length_scale: float
+    growth: GrowthFit | None
+    critical_thrust: float | None
+    classification: str
+    tolerances: dict = field(default_factory=dict)
+
+    @property
+    def displacement(self) -> Array:
+        """(k, 6) displacement of A (m) and Euler angles (rad) relative to the equilibrium."""
+        return self.deviation[:, :6]
+
+    @property
+    def absolute(self) -> Array:
+        """(k, 6) displacement of A from the unloaded position (m) and absolute Euler angles (rad)."""
+        return self.deviation[:, :6] + self.equilibrium[None, :6]
+
+    @property
+    def velocity(self) -> Array:
+        """(k, 6) body-frame velocity of A (m/s) and angular velocity (rad/s)."""
+        return self.deviation[:, 6:] + self.equilibrium[None, 6:]
+
+    def to_dict(self) -> dict:
+        """Settings and outcome without the time histories (JSON-ready)."""
+        out = {name: getattr(self, name) for name in _SCALARS}
+        out["perturbation"] = self.perturbation
+        out["equilibrium"] = self.equilibrium.tolist()
+        out["growth"] = None if self.growth is None else self.growth.to_dict()
+        out["tolerances"] = self.tolerances
+        return out
+
+    def to_xarray(self):
+        """Dataset with coordinate ``time``; variables by dof; settings in ``attrs``."""
+        import xarray as xr
+
+        from .. import __version__
+
+        data = {}
+        for j, name in enumerate(DOF_NAMES):
+            unit, vunit = ("m", "m/s") if j < 3 else ("rad", "rad/s")
+            what = "displacement of A" if j < 3 else "Euler angle"
+            data[name] = ("time", self.displacement[:, j],
+                          {"units": unit, "long_name": f"{name}: {what} from the equilibrium"})
+            data[f"{name}_absolute"] = ("time", self.absolute[:, j],
+                                        {"units": unit, "long_name": f"{name}: {what}, absolute"})
+            data[f"{name}_velocity"] = ("time", self.velocity[:, j],
+                                        {"units": vunit, "long_name": f"body-frame velocity {_VELOCITY_NAMES[j]}"})
+        data["thrust"] = ("time", self.thrust, {"units": "N"})
+        data["mount_force"] = (("time", "mount", "axis"), self.mount_loads[:, :, :3],
+                               {"units": "N", "long_name": "force of the mount on the body, hull frame"})
+        data["mount_moment"] = (("time", "mount", "axis"), self.mount_loads[:, :, 3:],
+                                {"units": "N m", "long_name": "moment of the mount on the body (rotational stiffness)"})
+        if self.error_estimate is not None:
+            data["error_estimate"] = ("time", self.error_estimate, {
+                "units": "1", "long_name": "Hamming relative local error estimate (9/121)|p - c|"})
+        attrs = {"title": f"time simulation of {self.model_name}", "impstab_version": __version__,
+                 "perturbation": json.dumps(self.perturbation), "equilibrium": self.equilibrium.tolist(),
+                 "growth": json.dumps(None if self.growth is None else self.growth.to_dict()),
+                 "tolerances": json.dumps(self.tolerances),
+                 "convention": "state deviation from the static equilibrium at T(0); Euler angles z-y-x; "
+                               "velocities in the body frame; growth rates in 1/s"}
+        for name in _SCALARS:
+            value = getattr(self, name)
+            if value is None:
+                continue
+            attrs[name] = int(value) if isinstance(value, bool) else value
+        if self.growth is not None:
+            attrs["growth_rate_fit"] = self.growth.rate
+            if self.growth.linear_rate is not None:
+                attrs["growth_rate_linear"] = self.growth.linear_rate
+        coords = {"time": ("time", self.time, {"units": "s"}), "mount": np.arange(self.mount_loads.shape[1]),
+                  "axis": ["x", "y", "z"]}
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    @classmethod
+    def from_xarray(cls, ds) -> "SimulationResult":
+        """Rebuild a result from :meth:`to_xarray` output (e.g. read back from netCDF)."""
+        a = ds.attrs
+        dev = np.column_stack([ds[n].values for n in DOF_NAMES] + [ds[f"{n}_velocity"].values for n in DOF_NAMES])
+        eq = np.asarray(a["equilibrium"], dtype=float)
+        dev[:, 6:] -= eq[None, 6:]
+        loads = np.concatenate([ds["mount_force"].values, ds["mount_moment"].values], axis=2)
+        g = json.loads(a.get("growth", "null"))
+        growth = None if g is None else GrowthFit(g["rate"], g["dof"], tuple(g["window"]), g["n_peaks"], g["envelope"],
+                                                  g["linear_rate"], g["thrust"])
+        kw = {f.name: None for f in fields(cls)}
+        kw.update({n: (a[n].item() if hasattr(a[n], "item") else a[n]) for n in _SCALARS if n in a})
+        kw.update(time=ds["time"].values, deviation=dev, equilibrium=eq, thrust=ds["thrust"].values, mount_loads=loads,
+                  error_estimate=ds["error_estimate"].values if "error_estimate" in ds else None,
+                  perturbation=json.loads(a["perturbation"]), growth=growth, completed=bool(a["completed"]),
+                  tolerances=json.loads(a.get("tolerances", "{}")))
+        return cls(**kw)
+
+    def plot(self, ax=None):
+        """Sway (m) and pitch (rad) against time, like the paper's Figures 5-6; returns the axes."""
+        from ..plot.simulation import plot_simulation
+
+        return plot_simulation(self, ax=ax)
+
+    def __repr__(self) -> str:
+        g = self.growth
+        rate = "n/a" if g is None or not math.isfinite(g.rate) else f"{g.rate:.4g} 1/s"
+        state = "completed" if self.completed else f"stopped: {self.stop_reason}"
+        return (f"SimulationResult({self.model_name!r}, {self.integrator}, {self.thrust_history}, "
+                f"{self.time.size} samples, {state}, growth {rate}, {self.classification})")
+
+
+def combine_results(results) -> "xarray.Dataset":  # noqa: F821
+    """Several runs (e.g. sub-, at and supercritical thrusts) in one dataset along ``case``.
+
+    Runs on the same time grid align exactly; a run that stopped early is padded with NaN.
+    Per-run outcomes become variables over ``case``; shared settings stay in ``attrs``.
+    """
+    import xarray as xr
+
+    sets = [r.to_xarray() for r in results]
+    per_case = {
+        "thrust_case": ("case", [float(r.thrust[0]) for r in results], {"units": "N", "long_name": "thrust at t = 0"}),
+        "classification": ("case", [r.classification for r in results]),
+        "envelope": ("case", [r.growth.envelope if r.growth else "" for r in results]),
+        "growth_rate_fit": ("case", [r.growth.rate if r.growth else np.nan for r in results], {"units": "1/s"}),
+        "growth_rate_linear": ("case", [np.nan if r.growth is None or r.growth.linear_rate is None
+                                        else r.growth.linear_rate for r in results], {"units": "1/s"}),
+        "completed": ("case", [int(r.completed) for r in results]),
+        "stop_reason": ("case", [r.stop_reason or "" for r in results]),
+    }
+    shared = ("impstab_version", "model_name", "integrator", "dt", "sample", "duration", "perturbation", "convention")
+    keep = {k: v for k, v in sets[0].attrs.items() if k in shared}
+    stripped = [ds.drop_attrs() if hasattr(ds, "drop_attrs") else ds.assign_attrs({}) for ds in sets]
+    out = xr.concat(stripped, dim="case", join="outer", combine_attrs="drop")
+    out = out.assign(per_case).assign_coords(case=np.arange(len(results)))
+    out.attrs = {**keep, "title": f"time simulations of {results[0].model_name} at {len(results)} thrusts"}
+    return out
+
+
+def results_to_dataframe(results):
+    """Long table (pandas) of one or several runs: one row per sample, column ``case_thrust``;
+    mount forces as ``mount{i}_f{x,y,z}`` (N)."""
+    import pandas as pd
+
+    frames = []
+    for r in results:
+        cols = {"case_thrust": np.full(r.time.size, float(r.thrust[0])), "time": r.time}
+        for j, name in enumerate(DOF_NAMES):
+            cols[name] = r.displacement[:, j]
+        for j, name in enumerate(DOF_NAMES):
+            cols[f"{name}_absolute"] = r.absolute[:, j]
+        for j, name in enumerate(DOF_NAMES):
+            cols[f"{name}_velocity"] = r.velocity[:, j]
+        cols["thrust"] = r.thrust
+        for i in range(r.mount_loads.shape[1]):
+            for a, ax in enumerate("xyz"):
+                cols[f"mount{i}_f{ax}"] = r.mount_loads[:, i, a]
+        frames.append(pd.DataFrame(cols))
+    return pd.concat(frames, ignore_index=True)

@@ -1,0 +1,230 @@
+"""``impstab.simulate``: nonlinear time histories of the propulsor under follower thrust."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Callable
+
+import numpy as np
+
+from ..errors import ModelError
+from ..linear.kinematics import matrix_to_euler_zyx
+from ..linear.linearize import linearize
+from ..model.model import DOF_NAMES, Model
+from .growth import classify, fit_run
+from .integrators import Problem, get_integrator
+from .loading import Perturbation, as_thrust_history
+from .rhs import PITCH_LIMIT
+from .system import pack_dynamics
+from .result import SimulationResult
+
+__all__ = ["simulate", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
+
+#: fixed steps per period of the fastest mode of the linearized system (Hamming's method is
+#: stable on the imaginary axis only for |h omega| below about 0.3; 40 steps give 0.157)
+STEPS_PER_PERIOD = 40
+#: default largest number of stored samples (the sampling interval grows beyond it)
+MAX_SAMPLES = 100_000
+#: floor of the SciPy methods' absolute tolerance, relative to the model's length scale
+ATOL_FLOOR = 1e-15
+
+
+class StepSizeWarning(UserWarning):
+    """A fixed step larger than the stability and accuracy limit of the fastest mode."""
+
+
+def _finite(field: str, value, positive: bool = True) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(field, value, "must be a number") from None
+    if not math.isfinite(v) or (positive and v <= 0):
+        raise ModelError(field, value, "must be a finite number > 0")
+    return v
+
+
+def fastest_mode(lin) -> tuple[float, str]:
+    """``(|lambda|_max (rad/s), dominant dof)`` of the linearized system ``lin``."""
+    vals, vecs = np.linalg.eig(lin.state_matrix())
+    j = int(np.argmax(np.abs(vals)))
+    shape = np.abs(vecs[:6, j]) * np.sqrt(np.diag(lin.M))
+    return float(np.abs(vals[j])), DOF_NAMES[int(np.argmax(shape))]
+
+
+def default_step(model: Model, thrust: float) -> float:
+    """Default fixed step (s) at constant thrust ``thrust`` (N): ``STEPS_PER_PERIOD`` per period of
+    the fastest mode of the system linearized at the static equilibrium."""
+    omega, _ = fastest_mode(linearize(model, float(thrust), "equilibrium"))
+    return 2 * math.pi / (STEPS_PER_PERIOD * omega)
+
+
+def _spin_law(model: Model) -> Callable:
+    prop, op = model.propeller, model.thrust.operating
+    if prop.speed_law == "sqrt-thrust":
+        return lambda t: prop.speed * np.sqrt(np.maximum(t, 0.0) / op)
+    return lambda t: np.full(np.shape(t), prop.speed)
+
+
+def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
+             dt: float | None = None, perturbation=None, sample: float | None = None, *,
+             tol: float | None = None, rtol: float = 1e-8, atol=None, pitch_limit: float = PITCH_LIMIT,
+             max_displacement: float | None = None, fit_window: tuple[float, float] | None = None,
+             critical_thrust: float | None | bool = True,
+             progress: Callable[[float], None] | None = None) -> SimulationResult:
+    """Integrate the nonlinear equations of motion from the static equilibrium under thrust.
+
+    Parameters
+    ----------
+    model : Model
+    thrust : float, ThrustHistory or callable
+        Thrust T (N): a constant, :class:`~impstab.dynamics.Ramp`, :class:`~impstab.dynamics.Step`
+        or any function ``f(t)`` of time (s). The run starts at the static equilibrium at ``T(0)``.
+    duration : float
+        Simulated time (s).
+    integrator : {"hamming", "gill", "dop853", "rk45", "radau", "lsoda"}
+    dt : float, optional
+        Fixed step (s) of ``hamming`` and ``gill``; default: ``STEPS_PER_PERIOD`` steps per period of
+        the fastest mode of the linearized system. A larger step warns (:class:`StepSizeWarning`).
+        For the SciPy methods it is the largest step (default unlimited). The step is shortened
+        slightly so that samples and the end of the run fall on steps.
+    perturbation : Perturbation, dict or None
+        Initial displacement (m, rad) and velocity (m/s, rad/s) per dof from the equilibrium;
+        default :meth:`Perturbation.default` (a small sway and yaw kick).
+    sample : float, optional
+        Sampling interval of the output (s); default every step (at most ``MAX_SAMPLES`` samples).
+    tol : float, optional
+        ``hamming`` only: step-size control on the relative local error per step (halve and
+        restart above ``tol``, double below ``tol / 64``, never above the default step).
+    rtol, atol : SciPy methods' tolerances (``atol`` default: ``rtol`` x the initial deviation, in
+        each state's units, but not below ``ATOL_FLOOR`` x the length scale).
+    pitch_limit : float
+        Stop when ``|theta|`` reaches it (rad); the Euler angles are singular at 90 degrees.
+    max_displacement : float, optional
+        Stop when a displacement of A from the equilibrium exceeds it (m); default 10 x the
+        model's length scale (the largest mount or thrust arm).
+    fit_window : (t0, t1), optional
+        Window of the envelope growth-rate fit (s); see :func:`~impstab.dynamics.growth.fit_run`.
+    critical_thrust : True, float, None or False
+        True computes the critical thrust for the classification; a number uses it; None means
+        stable up to ``thrust_max``; False skips the classification.
+    progress : callable, optional
+        Called with the fraction done between compiled chunks.
+
+    Returns
+    -------
+    SimulationResult
+    """
+    duration = _finite("duration", duration)
+    history = as_thrust_history(thrust)
+    solver = get_integrator(integrator)
+    if dt is not None:
+        dt = _finite("dt", dt)
+    if sample is not None:
+        sample = _finite("sample", sample)
+    pitch_limit = _finite("pitch_limit", pitch_limit)
+    if pitch_limit >= math.pi / 2:
+        raise ModelError("pitch_limit", pitch_limit, "must be below pi/2 rad (the Euler-angle singularity)")
+    pert = Perturbation.coerce(perturbation)
+    t0_thrust = float(history(0.0))
+    if not math.isfinite(t0_thrust):
+        raise ModelError("thrust", t0_thrust, "T(0) must be finite")
+    lin = linearize(model, t0_thrust, "equilibrium")
+    system = pack_dynamics(model, pitch_limit)
+    length = system.length_scale
+    yeq = np.zeros(12)
+    yeq[:3] = lin.displacement
+    yeq[3:6] = matrix_to_euler_zyx(lin.rotation)
+    z0 = pert.vector
+    if abs(yeq[4] + z0[4]) >= pitch_limit:
+        raise ModelError("perturbation.displacement.pitch", z0[4], "initial pitch must stay below pitch_limit")
+    # step from the fastest mode (at T(0), and at the extreme thrusts of a history)
+    omega, mode = fastest_mode(lin)
+    t_probe = history(np.linspace(0.0, duration, 257))
+    for t_other in (float(np.max(t_probe)), float(np.min(t_probe))):
+        if abs(t_other - t0_thrust) > 1e-6 * max(abs(t0_thrust), 1.0):
+            try:
+                om, md = fastest_mode(linearize(model, t_other, "equilibrium"))
+            except Exception:  # noqa: BLE001 - no equilibrium there: keep the value at T(0)
+                continue
+            if om > omega:
+                omega, mode = om, md
+    h_limit = 2 * math.pi / (STEPS_PER_PERIOD * omega)
+    if solver.fixed_step and dt is not None and dt > h_limit * (1 + 1e-9):
+        warnings.warn(
+            f"dt = {dt:.4g} s is larger than the limit {h_limit:.4g} s for the fastest mode ({mode}, "
+            f"{omega / (2 * math.pi):.4g} Hz): use at least {STEPS_PER_PERIOD} steps per period, or the "
+            f"integrator's own growth can look like flutter", StepSizeWarning, stacklevel=2)
+    h = dt if dt is not None else h_limit
+    if sample is None:
+        steps = math.ceil(duration / h)
+        sample = h * max(1, math.ceil(steps / MAX_SAMPLES))
+    n_samples = max(1, math.ceil(duration / sample - 1e-9))
+    sample = duration / n_samples
+    stride = max(1, math.ceil(sample / h - 1e-9))
+    h = sample / stride
+    spin = _spin_law(model)
+
+    def loads(t):
+        tt = np.asarray(history(t), dtype=float)
+        return np.vstack([tt, spin(tt)])
+
+    weights = np.array([1, 1, 1, length, length, length] + [1 / omega] * 3 + [length / omega] * 3)
+    # absolute tolerance (in metres after weighting): rtol x the initial deviation, floored at
+    # 1e-15 x the length scale, where the rounding of the absolute state (eps x |y_eq|) takes over
+    scale = max(float(np.max(np.abs(weights * z0))), 1e-9 * length)
+    atol_m = max(rtol * scale, ATOL_FLOOR * length)
+    problem = Problem(
+        system=system, yeq=yeq, z0=z0, t0=0.0, h=h, stride=stride, n_samples=n_samples, loads=loads,
+        weights=weights,
+        amp_limit=10 * length if max_displacement is None else _finite("max_displacement", max_displacement),
+        pitch_limit=pitch_limit, h_max=h_limit if solver.fixed_step else (dt or 0.0),
+        tol=0.0 if tol is None else _finite("tol", tol), rtol=_finite("rtol", rtol),
+        atol=np.asarray(atol, float) if atol is not None else atol_m / weights,
+        constant_load=(t0_thrust, float(spin(t0_thrust))) if history.is_constant else None,
+    )
+    raw = solver.run(problem, progress)
+    return _assemble(model, history, solver, problem, raw, lin, yeq, length, omega, mode, h_limit, pert,
+                     fit_window, critical_thrust, duration)
+
+
+def _assemble(model, history, solver, problem, raw, lin, yeq, length, omega, mode, h_limit, pert, fit_window,
+              critical_thrust, duration) -> SimulationResult:
+    from .system import mount_loads
+
+    thrust_t = np.asarray(history(raw.time), dtype=float).reshape(raw.time.shape)
+    loads6 = mount_loads(problem.system, yeq, raw.z)
+    t_end = float(thrust_t[-1]) if thrust_t.size else float(history(0.0))
+    lin_end = lin
+    if abs(t_end - lin.thrust) > 1e-9 * max(abs(lin.thrust), 1.0):
+        try:
+            lin_end = linearize(model, t_end, "equilibrium")
+        except Exception:  # noqa: BLE001 - no equilibrium at the final thrust
+            lin_end = None
+    linear_rate = None if lin_end is None else float(np.max(lin_end.eigenvalues().real))
+    growth = fit_run(raw.time, raw.z, length, fit_window, linear_rate, t_end)
+    crit = None
+    classification = "not computed"
+    if critical_thrust is not False:
+        if critical_thrust is True:
+            from ..errors import NumericalError
+            from ..linear.critical_thrust import critical_thrust as _ct
+
+            try:
+                crit = _ct(model, linearization="equilibrium").thrust
+                classification = classify(t_end, crit, model.analysis.thrust_max)
+            except NumericalError:
+                classification = "unknown"
+        else:
+            crit = None if critical_thrust is None else float(critical_thrust)
+            classification = classify(t_end, crit, model.analysis.thrust_max)
+    return SimulationResult(
+        time=raw.time, deviation=raw.z, equilibrium=yeq, thrust=thrust_t, mount_loads=loads6,
+        error_estimate=raw.error, model_name=model.name, integrator=solver.name, dt=problem.h,
+        final_dt=raw.final_step, sample=problem.sample, duration=duration, thrust_history=history.describe(),
+        perturbation=pert.to_dict(), completed=raw.completed, stop_reason=raw.reason, stop_time=raw.stop_time,
+        steps=raw.steps, rhs_evaluations=raw.rhs_evals, restarts=raw.restarts, wall_time=raw.wall_time,
+        fastest_omega=omega, fastest_mode=mode, step_limit=h_limit, length_scale=length, growth=growth,
+        critical_thrust=crit, classification=classification,
+        tolerances={"tol": problem.tol, "rtol": problem.rtol} if not solver.fixed_step or problem.tol else {},
+    )
