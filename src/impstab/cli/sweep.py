@@ -15,6 +15,12 @@ __all__ = ["commands"]
 _EXPORTS = (".nc", ".csv")
 
 
+class Interrupted(click.ClickException):
+    """The study was interrupted (Ctrl-C); what was finished is kept (exit code 130)."""
+
+    exit_code = 130
+
+
 def _console():
     from rich.console import Console
 
@@ -58,9 +64,8 @@ def sweep_cmd(study_file: str, store: str | None, workers: int | None, scheduler
     try:
         res = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress)
     except KeyboardInterrupt:
-        click.echo(f"impstab: interrupted; the chunks finished so far are kept in {out}: "
-                   "run the same command again to resume", err=True)
-        raise click.exceptions.Exit(130) from None
+        raise Interrupted(f"interrupted; the chunks finished so far are kept in {out}: "
+                          "run the same command again to resume") from None
     elapsed = time.perf_counter() - t0
     written = [str(res.export(p)) for p in exports]
     _summary(res, study, out, elapsed, written)

@@ -1,0 +1,196 @@
+"""Design study throughput: a 100 x 100 grid of the symmetric example over two mount parameters.
+
+Measured in one run on this machine:
+
+* **sweep** -- ``impstab.studies.run_study`` in process (one core), store on disk, end to end:
+  variant model files validated and assembled, batched scan across designs, exact refinement,
+  chunked zarr writes.
+* **loop** (the baseline) -- a plain loop of
+  ``impstab.critical_thrust(impstab.model.model_from_dict(variant))`` per design in the same
+  process, timed on a random subset of the designs (``--loop-sample``, default 500) and scaled
+  to the whole grid (said so in the output).
+* **LAPACK** -- the time ``np.linalg.eigvals`` alone needs for the eigenproblems the sweep
+  solves: the sweep's count of eigenproblems times the per-problem time of ``eigvals`` on a large
+  stack of the designs' own scan operators. ``lapack_fraction`` is that time over the sweep's.
+* **workers** -- the same study on a ``dask.distributed.LocalCluster`` of 1 and 2 worker
+  processes (one thread each), cluster started and warmed up before the clock starts. Beside
+  it, the machine's own parallelism: the same CPU-bound loop in 1 and then 2 processes at once
+  (on a machine whose two cores do not run two processes at full speed, no program scales).
+
+Ends with one JSON line:
+``{"designs_per_s", "speedup_vs_loop", "lapack_fraction", "workers_scaling": {"1", "2"}, ...}``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+import impstab
+from impstab.linear.critical import _Engine
+from impstab.linear.linearize import ModelFamily
+from impstab.model import model_from_dict
+from impstab.studies import load_study, run_study
+from impstab.studies.evaluate import variant_dict
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "imp_symmetric.toml"
+
+STUDY = """schema_version = 1
+name = "benchmark 100 x 100"
+model = "{model}"
+[[parameters]]
+path = "mount_rings[0].x"
+values = {{ start = 0.1, stop = 0.4, num = {n} }}
+[[parameters]]
+path = "mount_rings[0].k_shear"
+values = {{ start = 5e3, stop = 5e4, num = {n}, scale = "log" }}
+[execution]
+chunk_size = {chunk}
+"""
+
+
+def scan_operator_time(study, designs: np.ndarray, n_scan: int = 64) -> float:
+    """Seconds per eigenproblem of ``np.linalg.eigvals`` on a stack of the designs' scan operators."""
+    ops = []
+    for j in designs:
+        idx = np.unravel_index(j, study.shape)
+        vals = [p.values[i] for p, i in zip(study.parameters, idx)]
+        model = model_from_dict(variant_dict(study.base_model, [p.path.segments for p in study.parameters], vals))
+        eng = _Engine(ModelFamily(model), model.analysis.thrust_max)
+        grid = np.linspace(0.0, model.analysis.thrust_max, n_scan + 1)
+        ops.append(eng.operators(grid)[0])
+    stack = np.ascontiguousarray(np.concatenate(ops))
+    best = np.inf
+    for _ in range(5):
+        t0 = time.perf_counter()
+        np.linalg.eigvals(stack)
+        best = min(best, time.perf_counter() - t0)
+    return best / len(stack)
+
+
+def loop_time(study, designs: np.ndarray) -> float:
+    """Seconds per design of the plain loop (validation, assembly, critical_thrust)."""
+    segs = [p.path.segments for p in study.parameters]
+    dicts = []
+    for j in designs:
+        idx = np.unravel_index(j, study.shape)
+        dicts.append(variant_dict(study.base_model, segs, [p.values[i] for p, i in zip(study.parameters, idx)]))
+    impstab.critical_thrust(model_from_dict(dicts[0]))  # warm-up
+    t0 = time.perf_counter()
+    for d in dicts:
+        impstab.critical_thrust(model_from_dict(d))
+    return (time.perf_counter() - t0) / len(dicts)
+
+
+def timed_study(study, store: Path, **kw) -> tuple[float, object]:
+    t0 = time.perf_counter()
+    res = run_study(study, store, **kw)
+    return time.perf_counter() - t0, res
+
+
+def _spin(n: int) -> float:
+    s = 0.0
+    for i in range(n):
+        s += i * 0.5
+    return s
+
+
+def machine_parallelism(n: int = 4_000_000) -> float:
+    """Speed-up of 2 processes over 1 on the same CPU-bound loop (2.0 on two free cores)."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(2) as ex:
+        list(ex.map(_spin, [1000, 1000]))  # start both processes
+        t0 = time.perf_counter()
+        ex.submit(_spin, n).result()
+        one = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        list(ex.map(_spin, [n, n]))
+        two = time.perf_counter() - t0
+    return 2.0 * one / two
+
+
+def worker_rate(study, tmp: Path, n_workers: int) -> float:
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        client.run(lambda: impstab.critical_thrust(impstab.load_model(str(EXAMPLE))))  # import, JIT cache
+        seconds, _ = timed_study(study, tmp / f"w{n_workers}.zarr", client=client)
+    return study.size / seconds
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=100, help="grid points per parameter (default 100)")
+    ap.add_argument("--chunk", type=int, default=1000, help="designs per chunk")
+    ap.add_argument("--loop-sample", type=int, default=500, help="designs timed in the plain loop")
+    ap.add_argument("--no-workers", action="store_true", help="skip the Dask worker scaling")
+    args = ap.parse_args()
+    rng = np.random.default_rng(0)
+    with tempfile.TemporaryDirectory() as tmpdir:
+        tmp = Path(tmpdir)
+        path = tmp / "study.toml"
+        path.write_text(STUDY.format(model=EXAMPLE.as_posix(), n=args.n, chunk=args.chunk))
+        study = load_study(path)
+        n = study.size
+        run_study(load_study(path), None)  # warm-up of the whole path (JIT cache, imports)
+        seconds, res = timed_study(study, tmp / "local.zarr")
+        rate = n / seconds
+        evaluations = float(np.nansum(res_records(tmp / "local.zarr")))
+        subset = rng.choice(n, size=min(args.loop_sample, n), replace=False)
+        t_loop = loop_time(study, subset)
+        t_eig = scan_operator_time(study, rng.choice(n, size=min(200, n), replace=False))
+        t_lapack = evaluations * t_eig
+        counts = res.counts()
+        kinds = res.kind_names().values.ravel()
+        print(f"study            {n} designs ({args.n} x {args.n}) of {EXAMPLE.name}, chunks of {args.chunk}")
+        print(f"designs          ok {counts['ok']}, flutter {np.sum(kinds == 'flutter')}, "
+              f"stable to thrust_max {np.sum(kinds == 'none')}, failed {n - counts['ok']}")
+        print(f"sweep (1 core)   {seconds:.2f} s  = {rate:,.0f} designs/s  ({seconds / n * 1e6:.0f} us/design)")
+        print(f"plain loop       {t_loop * 1e6:.0f} us/design, timed on {len(subset)} random designs, "
+              f"scaled to {n}: {t_loop * n:.1f} s")
+        print(f"speedup          {t_loop * n / seconds:.2f}x")
+        print(f"eigenproblems    {evaluations / n:.1f} per design; eigvals alone {t_eig * 1e6:.2f} us each "
+              f"-> LAPACK {t_lapack:.2f} s = {t_lapack / seconds:.1%} of the sweep")
+        scaling = {}
+        if not args.no_workers:
+            for w in (1, 2):
+                scaling[str(w)] = worker_rate(study, tmp, w)
+                print(f"dask {w} worker{'s' if w > 1 else ' '}   {scaling[str(w)]:,.0f} designs/s "
+                      f"({n / scaling[str(w)]:.2f} s for the map)")
+            parallel = machine_parallelism()
+            print(f"worker scaling   {scaling['2'] / scaling['1']:.2f}x from 1 to 2 workers; this machine runs "
+                  f"2 CPU-bound processes {parallel:.2f}x as fast as 1")
+    line = {
+        "designs_per_s": rate,
+        "speedup_vs_loop": t_loop * n / seconds,
+        "lapack_fraction": t_lapack / seconds,
+        "workers_scaling": scaling,
+        "designs": n,
+        "loop_us_per_design": t_loop * 1e6,
+        "loop_timed_on": len(subset),
+        "eigenproblems_per_design": evaluations / n,
+    }
+    if scaling:
+        line["machine_parallelism_2_processes"] = parallel
+    print(json.dumps(line))
+    return 0
+
+
+def res_records(store: Path) -> np.ndarray:
+    """Eigenproblems solved per chunk, from the store's progress records."""
+    import zarr
+
+    return zarr.open_group(str(store), mode="r")["progress/chunks"][:, 3]
+
+
+if __name__ == "__main__":
+    sys.exit(main())

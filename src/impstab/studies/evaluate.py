@@ -1,0 +1,133 @@
+"""Evaluation of one chunk of designs: variant model files -> models -> batched critical thrust.
+
+:func:`evaluate_chunk` is the unit of work, in process or on a Dask worker. Its input
+(:class:`ChunkTask`) holds only the base model, the parameter paths and this chunk's parameter
+values; its output (:class:`ChunkResult`) only this chunk's results. Every variant is validated
+like a model file (:func:`impstab.model.model_from_dict`); a variant that breaks a rule, or whose
+analysis fails, gets a status and a message and the others go on.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import ModelError
+from ..linear.batch import STATUSES, critical_thrust_batch
+from ..model.assemble import model_from_dict
+from .paths import set_values
+
+__all__ = ["ChunkTask", "ChunkResult", "evaluate_chunk", "variant_dict", "CODE_OUTPUTS"]
+
+#: outputs stored as int8 codes into :data:`impstab.linear.batch.KINDS`
+CODE_OUTPUTS = ("kind", "undamped_kind")
+
+
+@dataclass(frozen=True, eq=False)
+class ChunkTask:
+    """Everything a worker needs for one chunk (small: no other chunk's data).
+
+    Attributes
+    ----------
+    index : int
+        Chunk number in the plan.
+    block : tuple of int
+        Shape of the chunk's block of the design array.
+    base_model : dict
+        The parsed base model file.
+    segments : tuple
+        Each parameter's path as keys and indices.
+    columns : tuple of arrays
+        Each parameter's value at each design of the chunk (flattened, C order).
+    outputs : tuple of str
+    model_name : str
+    """
+
+    index: int
+    block: tuple[int, ...]
+    base_model: dict
+    segments: tuple[tuple[str | int, ...], ...]
+    columns: tuple[NDArray, ...]
+    outputs: tuple[str, ...]
+    model_name: str = "model"
+
+
+@dataclass(frozen=True, eq=False)
+class ChunkResult:
+    """Results of one chunk: each output, the status codes and messages, as block-shaped arrays."""
+
+    index: int
+    data: dict[str, NDArray] = field(default_factory=dict)
+    seconds: float = 0.0
+    evaluations: int = 0
+
+    @property
+    def size(self) -> int:
+        return int(self.data["status"].size)
+
+
+def variant_dict(base: dict, segments, values) -> dict:
+    """The model-file dict of one design: ``base`` with each path set to its value."""
+    vals = [v.item() if isinstance(v, np.generic) else v for v in values]
+    return set_values(base, [tuple(s) for s in segments], vals)
+
+
+def evaluate_chunk(task: ChunkTask) -> ChunkResult:
+    """Critical thrust (and the other outputs) of every design in the chunk.
+
+    Parameters
+    ----------
+    task : ChunkTask
+
+    Returns
+    -------
+    ChunkResult
+        Arrays of shape ``task.block``; ``status`` codes index :data:`impstab.linear.batch.STATUSES`.
+    """
+    t0 = time.perf_counter()
+    n = len(task.columns[0]) if task.columns else 1
+    models: list = []
+    errors: dict[int, str] = {}
+    for j in range(n):
+        d = variant_dict(task.base_model, task.segments, [c[j] for c in task.columns])
+        try:
+            models.append(model_from_dict(d, name=task.model_name))
+        except ModelError as exc:
+            models.append(None)
+            errors[j] = str(exc)
+        except Exception as exc:  # noqa: BLE001 - a variant never stops the study
+            models.append(None)
+            errors[j] = f"{type(exc).__name__}: {exc}"
+    res = critical_thrust_batch(models)
+    status = res.status.copy()
+    message = list(res.message)
+    for j, text in errors.items():
+        status[j] = STATUSES.index("invalid")
+        message[j] = text
+    failed = status != 0
+    values = {
+        "critical_thrust": res.thrust,
+        "frequency_hz": res.frequency_hz,
+        "omega": res.omega,
+        "margin": res.margin,
+        "undamped_critical_thrust": res.undamped_thrust,
+        "thrust_max": res.thrust_max,
+        "operating_thrust": res.operating,
+        "kind": res.kind,
+        "undamped_kind": res.undamped_kind,
+    }
+    data: dict[str, NDArray] = {}
+    for name in task.outputs:
+        if name == "modes":
+            arr = np.array(["" if failed[j] else res.modes[j] for j in range(n)], dtype=np.str_)
+        elif name in CODE_OUTPUTS:
+            arr = np.where(failed, -1, values[name]).astype(np.int8)
+        else:
+            arr = np.where(failed, np.nan, values[name]).astype(np.float64)
+        data[name] = arr.reshape(task.block)
+    data["status"] = status.astype(np.int8).reshape(task.block)
+    data["message"] = np.array(message, dtype=np.str_).reshape(task.block)
+    return ChunkResult(task.index, data, time.perf_counter() - t0, res.evaluations)

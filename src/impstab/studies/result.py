@@ -1,0 +1,269 @@
+"""Results of a design study: the Dataset, the best design, the stability map, exports."""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ModelError
+
+__all__ = ["StudyResult", "open_study"]
+
+
+@dataclass(frozen=True, eq=False)
+class StudyResult:
+    """The results of a study, loaded in memory.
+
+    Attributes
+    ----------
+    dataset : xarray.Dataset
+        One variable per output plus ``status`` (codes in ``attrs["flag_meanings"]``) and
+        ``message``; one dimension per grid parameter, or ``sample``; the study file, the base
+        model, the package version and timestamps in ``attrs``.
+    store : str or None
+        Where the results are stored (None for an in-memory study).
+    """
+
+    dataset: Any
+    store: str | None = None
+
+    @classmethod
+    def from_store(cls, st) -> "StudyResult":
+        return cls(st.open_dataset().load(), None if st.path is None else str(st.path))
+
+    # -- views --------------------------------------------------------------------------------
+    @property
+    def parameters(self) -> list[str]:
+        """Parameter paths, in the order of the study file."""
+        return json.loads(self.dataset.attrs["parameters"])
+
+    @property
+    def complete(self) -> bool:
+        """Whether every design has been computed."""
+        return bool((self.dataset["status"] >= 0).all())
+
+    def counts(self) -> dict[str, int]:
+        """Number of designs per status (``not_computed`` for status -1)."""
+        meanings = self.dataset["status"].attrs["flag_meanings"].split()
+        codes = self.dataset["status"].values.ravel()
+        out = {m: int(np.count_nonzero(codes == k)) for k, m in enumerate(meanings)}
+        out["not_computed"] = int(np.count_nonzero(codes < 0))
+        return out
+
+    def to_xarray(self):
+        """The results as an xarray Dataset (a copy)."""
+        return self.dataset.copy()
+
+    def kind_names(self, var: str = "kind"):
+        """``var`` (a kind code variable) as strings: ``"flutter"``, ``"divergence"``, ``"none"`` or ``""``."""
+        meanings = np.array(self.dataset[var].attrs["flag_meanings"].split() + [""])
+        return self.dataset[var].copy(data=meanings[self.dataset[var].values.astype(int)])
+
+    def best(self, by: str = "margin", *, minimum: bool = False, where=None) -> dict[str, Any]:
+        """The design with the largest (or smallest) value of ``by`` among the computed designs.
+
+        A design that stays stable over the whole search (kind ``"none"``) has no critical
+        thrust; it ranks with its search limit (``thrust_max``, or ``thrust_max / operating`` for
+        the margin) as a lower bound, and the answer says so (``"lower_bound": True``).
+
+        Parameters
+        ----------
+        by : str
+            ``"margin"``, ``"critical_thrust"`` or any other float output.
+        minimum : bool
+            The smallest value instead (the worst design).
+        where : boolean DataArray or array, optional
+            Only these designs, e.g. ``ds["kind"] == 1`` (flutter within the search range).
+
+        Returns
+        -------
+        dict
+            ``parameters`` (path -> value), ``value`` (of ``by``, or its lower bound), ``values``
+            (every stored output), ``index`` (position in the design array), ``lower_bound`` and
+            ``tied`` (number of designs sharing the value).
+        """
+        ds = self.dataset
+        if by not in ds.data_vars or ds[by].dtype.kind != "f":
+            known = [v for v in ds.data_vars if ds[v].dtype.kind == "f"]
+            raise ModelError("by", by, f"must be one of the stored real outputs {known}")
+        value = ds[by].values.astype(float)
+        bound = np.zeros(value.shape, dtype=bool)
+        if by in ("margin", "critical_thrust") and "kind" in ds:
+            stable = (ds["kind"].values == 0) & (ds["status"].values == 0)
+            limit = self.search_limit(by)
+            if limit is not None:
+                value = np.where(stable, limit, value)
+                bound = stable
+        if where is not None:
+            mask = where.broadcast_like(ds[by]).transpose(*ds[by].dims).values if hasattr(where, "dims") else np.asarray(where)
+            value = np.where(np.broadcast_to(mask, value.shape), value, np.nan)
+        if not np.isfinite(value).any():
+            raise ModelError("by", by, "no computed (and selected) design has a value for it")
+        pick = np.where(np.isfinite(value), value, np.inf if minimum else -np.inf)
+        flat = int(np.argmin(pick) if minimum else np.argmax(pick))
+        idx = np.unravel_index(flat, value.shape)
+        sel = dict(zip(ds[by].dims, idx))
+        point = ds.isel(sel)
+        params = {p: _plain(point[p].values) for p in self.parameters}
+        values = {v: _plain(point[v].values) for v in ds.data_vars}
+        for v in ("kind", "undamped_kind"):
+            if v in ds:
+                values[v] = self.kind_names(v).isel(sel).item()
+        return {
+            "parameters": params,
+            "value": float(value[idx]),
+            "values": values,
+            "index": {d: int(i) for d, i in sel.items()},
+            "lower_bound": bool(bound[idx]),
+            "tied": int(np.count_nonzero(pick == pick[idx])),
+        }
+
+    def operating_thrust(self):
+        """Operating thrust of every design (N), an array shaped like the designs; None if unset."""
+        return self._per_design("operating_thrust", "thrust.operating", "thrust", "operating")
+
+    def thrust_max(self):
+        """Upper end of every design's critical-thrust search (N); None if unknown."""
+        t_max = self._per_design("thrust_max", "analysis.thrust_max", "analysis", "thrust_max")
+        op = self.operating_thrust()
+        if t_max is None and op is not None:
+            t_max = 10.0 * op  # the model-file default
+        return t_max
+
+    def search_limit(self, by: str = "critical_thrust"):
+        """Per-design end of the search: ``thrust_max`` (N), or ``thrust_max / operating`` for
+        ``by="margin"``; None when unknown. A design stable up to it has at least this value."""
+        t_max, op = self.thrust_max(), self.operating_thrust()
+        if by == "critical_thrust" or t_max is None:
+            return t_max
+        if op is None:
+            return None
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return t_max / op
+
+    def _per_design(self, output: str, path: str, section: str, key: str):
+        ds = self.dataset
+        ref = ds["status"]
+        if output in ds:
+            return ds[output].values.astype(float)
+        if path in ds.coords:
+            return ds[path].broadcast_like(ref).transpose(*ref.dims).values.astype(float)
+        value = _base_value(ds.attrs, section, key)
+        return None if value is None else np.full(ref.shape, float(value))
+
+    def model_dict(self, parameters: dict[str, Any]) -> dict:
+        """The model-file dict of one design: the stored base model with ``parameters`` set.
+
+        ``parameters`` maps paths to values, e.g. ``result.best()["parameters"]``.
+        """
+        import tomllib
+
+        from .evaluate import variant_dict
+        from .paths import parse_path
+
+        unknown = [p for p in parameters if p not in self.parameters]
+        if unknown:
+            raise ModelError("parameters", unknown, f"are not parameters of this study {self.parameters}")
+        base = tomllib.loads(self.dataset.attrs["model_file"])
+        return variant_dict(base, [parse_path(p) for p in parameters], list(parameters.values()))
+
+    def model(self, parameters: dict[str, Any]):
+        """The :class:`~impstab.model.Model` of one design (validated like a model file)."""
+        from ..model.assemble import model_from_dict
+
+        return model_from_dict(self.model_dict(parameters), name=self.dataset.attrs.get("model_name", "model"))
+
+    def plot(self, ax=None, *, x: str | None = None, y: str | None = None, value: str = "critical_thrust",
+             at: dict[str, Any] | None = None):
+        """Draw the stability map; returns the matplotlib Axes.
+
+        See :func:`impstab.plot.stability_map.plot_stability_map`.
+        """
+        from ..plot.stability_map import plot_stability_map
+
+        return plot_stability_map(self, ax=ax, x=x, y=y, value=value, at=at)
+
+    # -- exports ------------------------------------------------------------------------------
+    def to_netcdf(self, path: str | os.PathLike[str]) -> Path:
+        """Write the results to a netCDF file (written to a temporary name, then renamed)."""
+        from ..io import atomic_path
+
+        with atomic_path(path) as tmp:
+            self.dataset.to_netcdf(tmp, engine="h5netcdf")
+        return Path(path)
+
+    def to_csv(self, path: str | os.PathLike[str]) -> Path:
+        """Write one row per design (parameters, outputs, status, message) to a CSV file."""
+        from ..io import atomic_path
+
+        ds = self.dataset
+        frame = ds.to_dataframe().reset_index()
+        for v in ("kind", "undamped_kind", "status"):
+            if v in ds:
+                names = np.array(ds[v].attrs["flag_meanings"].split() + ["not_computed" if v == "status" else ""])
+                frame[v] = names[frame[v].to_numpy().astype(int)]
+        first = [c for c in ("sample", *self.parameters) if c in frame.columns]
+        frame = frame[first + [c for c in frame.columns if c not in first]]
+        with atomic_path(path) as tmp:
+            frame.to_csv(tmp, index=False)
+        return Path(path)
+
+    def export(self, path: str | os.PathLike[str]) -> Path:
+        """Write to ``.nc`` (netCDF) or ``.csv`` by the file's extension."""
+        suffix = Path(path).suffix.lower()
+        if suffix == ".nc":
+            return self.to_netcdf(path)
+        if suffix == ".csv":
+            return self.to_csv(path)
+        raise ModelError("--export", str(path), "must end in .nc (netCDF) or .csv")
+
+
+def _plain(v):
+    v = np.asarray(v)
+    return v.item() if v.ndim == 0 else v.tolist()
+
+
+def _base_value(attrs: dict, section: str, key: str):
+    import tomllib
+
+    try:
+        return tomllib.loads(attrs.get("model_file", "")).get(section, {}).get(key)
+    except tomllib.TOMLDecodeError:
+        return None
+
+
+def open_study(store: str | os.PathLike[str]) -> StudyResult:
+    """Load the results of a study: its zarr store (complete or not) or a netCDF export.
+
+    Raises
+    ------
+    ModelError
+        If ``store`` is neither.
+    """
+    import xarray as xr
+
+    from .store import tidy
+
+    p = Path(store)
+    if p.is_file() and p.suffix.lower() == ".nc":
+        try:
+            ds = xr.load_dataset(p, engine="h5netcdf")
+        except Exception as exc:  # noqa: BLE001 - any unreadable file is "not a study"
+            raise ModelError("STORE", str(p), f"cannot be read as netCDF ({type(exc).__name__})") from None
+        if not str(ds.attrs.get("format", "")).startswith("impstab-study-store"):
+            raise ModelError("STORE", str(p), "is not an export of an impstab study")
+        return StudyResult(tidy(ds), None)
+    if not p.is_dir():
+        raise ModelError("STORE", str(p), "is not a folder (give the zarr store written by 'impstab sweep', or its .nc export)")
+    try:
+        ds = xr.open_zarr(str(p), consolidated=None, chunks=None)
+    except Exception as exc:  # noqa: BLE001 - any unreadable folder is "not a store"
+        raise ModelError("STORE", str(p), f"cannot be read as a zarr store ({type(exc).__name__})") from None
+    if not str(ds.attrs.get("format", "")).startswith("impstab-study-store"):
+        raise ModelError("STORE", str(p), "is not an impstab study store")
+    return StudyResult(tidy(ds).load(), str(p))

@@ -1,0 +1,122 @@
+"""Study file schema (TOML, ``schema_version = 1``): pydantic at the file boundary only.
+
+.. code-block:: toml
+
+    schema_version = 1
+    model = "imp.toml"                  # base model, relative to the study file
+    outputs = ["critical_thrust", "kind", "frequency_hz", "margin", "undamped_critical_thrust"]
+
+    [[parameters]]
+    path = "mount_rings[0].x"           # dotted path into the model file
+    values = { start = 0.1, stop = 0.4, num = 60 }            # or a list: values = [0.1, 0.2]
+
+    [[parameters]]
+    path = "mount_rings[0].k_shear"
+    values = { start = 1e4, stop = 1e6, num = 60, scale = "log" }
+
+    [sampling]                          # optional
+    method = "grid"                     # "grid" | "random" | "sobol"
+    # n = 10000; seed = 1               # random / sobol
+
+    [execution]                         # optional
+    chunk_size = 1024                   # designs per chunk (the unit of work and of resuming)
+
+With ``random`` or ``sobol`` sampling each parameter is drawn from ``values`` (a range without
+``num``: uniform, or log-uniform with ``scale = "log"``; a list: each entry equally likely) or
+from a ``distribution`` table: ``{kind = "normal", mean, std}``, ``{kind = "lognormal", median,
+sigma}``, ``{kind = "truncnormal", mean, std, low, high}``, ``{kind = "uniform" | "loguniform",
+low, high}``.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr, field_validator
+
+__all__ = ["StudyFile", "ParameterSpec", "RangeSpec", "DistributionSpec", "OUTPUTS", "DEFAULT_OUTPUTS"]
+
+#: every output a study can store, with its units and meaning
+OUTPUTS = {
+    "critical_thrust": ("N", "critical thrust (first loss of stability from T = 0)"),
+    "kind": ("", "kind of instability at the critical thrust"),
+    "frequency_hz": ("Hz", "frequency at onset"),
+    "omega": ("rad/s", "angular frequency at onset"),
+    "margin": ("1", "critical thrust / operating thrust"),
+    "undamped_critical_thrust": ("N", "critical thrust with every damper removed"),
+    "undamped_kind": ("", "kind of instability with every damper removed"),
+    "modes": ("", "dofs with at least 5 % of the kinetic energy of the critical mode"),
+    "thrust_max": ("N", "upper end of the critical-thrust search"),
+    "operating_thrust": ("N", "operating thrust"),
+}
+DEFAULT_OUTPUTS = ("critical_thrust", "kind", "frequency_hz", "margin", "undamped_critical_thrust")
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Scalar = Union[StrictBool, StrictInt, StrictFloat, StrictStr]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class RangeSpec(_Strict):
+    """``start`` to ``stop``: ``num`` points for a grid, a uniform range for random sampling."""
+
+    start: Finite
+    stop: Finite
+    num: Optional[Annotated[int, Field(ge=1, le=10_000_000)]] = None
+    scale: Literal["linear", "log"] = "linear"
+
+
+class DistributionSpec(_Strict):
+    """A probability distribution of one parameter (random and sobol sampling)."""
+
+    kind: Literal["uniform", "loguniform", "normal", "lognormal", "truncnormal"]
+    low: Optional[Finite] = None
+    high: Optional[Finite] = None
+    mean: Optional[Finite] = None
+    std: Optional[Annotated[float, Field(gt=0, allow_inf_nan=False)]] = None
+    median: Optional[Annotated[float, Field(gt=0, allow_inf_nan=False)]] = None
+    sigma: Optional[Annotated[float, Field(gt=0, allow_inf_nan=False)]] = None
+
+
+class ParameterSpec(_Strict):
+    path: str
+    values: Optional[Union[RangeSpec, Annotated[list[Scalar], Field(min_length=1)]]] = None
+    distribution: Optional[DistributionSpec] = None
+
+
+class SamplingSpec(_Strict):
+    method: Literal["grid", "random", "sobol"] = "grid"
+    n: Optional[Annotated[int, Field(ge=1, le=100_000_000)]] = None
+    seed: Annotated[int, Field(ge=0)] = 0
+
+
+class ExecutionSpec(_Strict):
+    chunk_size: Annotated[int, Field(ge=1, le=1_000_000)] = 1024
+
+
+class StudyFile(_Strict):
+    """The whole study file."""
+
+    schema_version: int
+    name: Optional[str] = None
+    model: str
+    outputs: Annotated[list[Literal[tuple(OUTPUTS)]], Field(min_length=1)] = list(DEFAULT_OUTPUTS)  # type: ignore[valid-type]
+    parameters: Annotated[list[ParameterSpec], Field(min_length=1, max_length=32)]
+    sampling: SamplingSpec = SamplingSpec()
+    execution: ExecutionSpec = ExecutionSpec()
+
+    @field_validator("schema_version")
+    @classmethod
+    def _version(cls, v: int) -> int:
+        if v != 1:
+            raise ValueError("this impstab reads study files with schema_version 1")
+        return v
+
+    @field_validator("outputs")
+    @classmethod
+    def _unique(cls, v: list[str]) -> list[str]:
+        if len(set(v)) != len(v):
+            raise ValueError("lists an output twice")
+        return v

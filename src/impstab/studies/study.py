@@ -1,0 +1,268 @@
+"""A validated design study: base model, parameters and their values, outputs, chunking.
+
+:func:`load_study` reads a study file and checks everything that can be checked before anything
+runs: the file against its schema, the base model like a model file, every parameter path
+against the model schema and the base model, and every grid value (or the range of a
+distribution) against the rule of its field. Each failure is a one-line
+:class:`~impstab.errors.ModelError` naming the field, the value and the rule.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import ValidationError
+
+from ..errors import ModelError
+from ..model.assemble import format_location, model_from_dict, read_toml
+from .paths import ParameterPath, resolve_path
+from .sampling import axis_values, check_distribution, map_samples, unit_samples
+from .schema import ParameterSpec, RangeSpec, StudyFile
+
+__all__ = ["Study", "Parameter", "load_study", "study_from_dict", "describe", "MAX_DESIGNS"]
+
+#: largest number of designs in one study
+MAX_DESIGNS = 100_000_000
+
+
+@dataclass(frozen=True, eq=False)
+class Parameter:
+    """One varied model-file value.
+
+    Attributes
+    ----------
+    path : ParameterPath
+        Where the value goes in the model file.
+    values : (k,) array
+        Grid axis (grid sampling) or the value of every sample (random, sobol).
+    """
+
+    path: ParameterPath
+    values: NDArray
+
+    @property
+    def name(self) -> str:
+        """The path as written in the study file (also the name of its coordinate)."""
+        return self.path.path
+
+
+@dataclass(frozen=True, eq=False)
+class Study:
+    """A design study ready to run (see :func:`load_study`)."""
+
+    name: str
+    method: str
+    parameters: tuple[Parameter, ...]
+    outputs: tuple[str, ...]
+    chunk_size: int
+    base_model: dict
+    model_name: str
+    study_text: str
+    model_text: str
+    fingerprint: str
+    source: str | None = None
+    model_source: str | None = None
+    seed: int = 0
+
+    @property
+    def dims(self) -> tuple[str, ...]:
+        """Dimensions of the results: one per parameter for a grid, else ``("sample",)``."""
+        return tuple(p.name for p in self.parameters) if self.method == "grid" else ("sample",)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        if self.method == "grid":
+            return tuple(len(p.values) for p in self.parameters)
+        return (len(self.parameters[0].values),)
+
+    @property
+    def size(self) -> int:
+        """Number of designs."""
+        return int(np.prod(self.shape))
+
+
+def _shown(value: Any) -> Any:
+    """A table of the study file as the user wrote it (keys that were given)."""
+    return value.model_dump(exclude_none=True) if hasattr(value, "model_dump") else value
+
+
+def _schema_error(err: ValidationError) -> ModelError:
+    first = err.errors()[0]
+    loc = tuple(p for p in first["loc"] if not (isinstance(p, str) and ("[" in p or p.startswith("function-"))))
+    field = format_location(loc)
+    kind = first["type"]
+    if kind == "extra_forbidden":
+        return ModelError(field, first.get("input"), "unknown key (check the spelling against the study-file schema)")
+    if kind == "missing":
+        return ModelError(field, None, "is required")
+    msg = first["msg"].replace("Value error, ", "").replace("Input should be", "must be")
+    return ModelError(field, first.get("input"), msg[0].lower() + msg[1:])
+
+
+def _checked(par: ParameterPath, values: list, field: str) -> NDArray:
+    """Values converted by the field's schema rule, as an array of the field's type."""
+    out = []
+    for v in values:
+        v = v.item() if isinstance(v, np.generic) else v
+        if par.kind == "int" and isinstance(v, float) and v.is_integer():
+            v = int(v)
+        try:
+            out.append(par.check(v))
+        except ValueError as exc:
+            raise ModelError(field, v, f"{exc} (the rule of {par.path})") from None
+    dtype = {"float": np.float64, "int": np.int64, "bool": np.bool_, "str": np.str_}[par.kind]
+    return np.asarray(out, dtype=dtype)
+
+
+def _grid_axis(spec: ParameterSpec, par: ParameterPath, i: int) -> NDArray:
+    f = f"parameters[{i}]"
+    if spec.distribution is not None:
+        raise ModelError(f"{f}.distribution", spec.distribution.kind, "is only used with sampling.method = 'random' or 'sobol'")
+    if spec.values is None:
+        raise ModelError(f"{f}.values", None, "is required: a range {start, stop, num} or a list")
+    if isinstance(spec.values, RangeSpec) and spec.values.num is None:
+        raise ModelError(f"{f}.values.num", None, "is required for grid sampling (the number of values)")
+    try:
+        axis = axis_values(spec)
+    except ValueError as exc:
+        raise ModelError(f"{f}.values", _shown(spec.values), str(exc)) from None
+    if par.kind == "int" and isinstance(spec.values, RangeSpec):
+        rounded = np.round(axis)
+        if not np.allclose(axis, rounded, rtol=0, atol=1e-9 * max(1.0, np.abs(axis).max())):
+            raise ModelError(f"{f}.values", _shown(spec.values), f"{par.path} is an integer: the range must hit integers (or give a list)")
+        axis = rounded.astype(np.int64).tolist()
+    elif isinstance(axis, np.ndarray):
+        axis = axis.tolist()
+    values = _checked(par, axis, f"{f}.values")
+    if len(np.unique(values)) != len(values):
+        raise ModelError(f"{f}.values", axis if len(axis) < 12 else f"{len(axis)} values", "must be distinct")
+    return values
+
+
+def _sample_column(spec: ParameterSpec, par: ParameterPath, i: int, u: NDArray) -> NDArray:
+    f = f"parameters[{i}]"
+    try:
+        check_distribution(spec)
+    except ValueError as exc:
+        key = "distribution" if spec.distribution is not None else "values"
+        raise ModelError(f"{f}.{key}", _shown(getattr(spec, key)), str(exc)) from None
+    if isinstance(spec.values, list):
+        _checked(par, spec.values, f"{f}.values")
+        return _checked(par, map_samples(spec, u), f"{f}.values")
+    if par.kind != "float":
+        raise ModelError(f"{f}.values", par.kind, f"{par.path} is not a real number: give a list of values to draw from")
+    ends = []
+    if isinstance(spec.values, RangeSpec):
+        ends = [spec.values.start, spec.values.stop]
+    elif spec.distribution.low is not None:
+        ends = [spec.distribution.low, spec.distribution.high]
+    _checked(par, ends, f"{f}.{'values' if spec.values is not None else 'distribution'}")
+    return np.asarray(map_samples(spec, u), dtype=np.float64)
+
+
+def study_from_dict(
+    data: dict,
+    base_dir: str | os.PathLike[str] = ".",
+    *,
+    source: str | None = None,
+    text: str | None = None,
+) -> Study:
+    """Validate a parsed study file; the base model path is relative to ``base_dir``.
+
+    Raises
+    ------
+    ModelError
+        One line naming the field, the value and the rule.
+    """
+    if not isinstance(data, dict):
+        raise ModelError("(study file)", type(data).__name__, "must be a table of study keys")
+    if "schema_version" not in data:
+        raise ModelError("schema_version", None, "is required (schema_version = 1)")
+    try:
+        doc = StudyFile.model_validate(data)
+    except ValidationError as err:
+        raise _schema_error(err) from None
+    model_path = Path(base_dir) / doc.model
+    try:
+        base = read_toml(model_path, "model")
+    except ModelError as err:
+        raise ModelError("model", doc.model, f"{err.rule} ({model_path})") from None
+    try:
+        model = model_from_dict(base, name=model_path.stem, source=str(model_path))
+    except ModelError as err:
+        raise ModelError(f"{err.field} (in base model {doc.model})", err.value, err.rule) from None
+    paths: list[ParameterPath] = []
+    for i, spec in enumerate(doc.parameters):
+        try:
+            par = resolve_path(spec.path, base)
+        except ValueError as exc:
+            raise ModelError(f"parameters[{i}].path", spec.path, str(exc)) from None
+        if any(p.segments == par.segments for p in paths):
+            raise ModelError(f"parameters[{i}].path", spec.path, "is already varied by another parameter")
+        paths.append(par)
+    method = doc.sampling.method
+    if method == "grid":
+        if doc.sampling.n is not None:
+            raise ModelError("sampling.n", doc.sampling.n, "is only used with random or sobol sampling (a grid has the product of the nums)")
+        columns = [_grid_axis(s, p, i) for i, (s, p) in enumerate(zip(doc.parameters, paths))]
+        size = int(np.prod([len(c) for c in columns], dtype=float))
+    else:
+        if doc.sampling.n is None:
+            raise ModelError("sampling.n", None, f"is required with sampling.method = {method!r} (the number of samples)")
+        size = doc.sampling.n
+    if size > MAX_DESIGNS:
+        raise ModelError("parameters", f"{size} designs", f"more than {MAX_DESIGNS} designs in one study")
+    if method != "grid":
+        u = unit_samples(method, size, len(paths), doc.sampling.seed)
+        columns = [_sample_column(s, p, i, u[:, i]) for i, (s, p) in enumerate(zip(doc.parameters, paths))]
+    canonical = json.dumps({"study": doc.model_dump(mode="json"), "model": base}, sort_keys=True, default=str)
+    return Study(
+        name=doc.name or (Path(source).stem if source else "study"),
+        method=method,
+        parameters=tuple(Parameter(p, c) for p, c in zip(paths, columns)),
+        outputs=tuple(doc.outputs),
+        chunk_size=doc.execution.chunk_size,
+        base_model=base,
+        model_name=model.name,
+        study_text=text if text is not None else json.dumps(data, default=str),
+        model_text=model_path.read_text(encoding="utf-8"),
+        fingerprint=hashlib.sha256(canonical.encode()).hexdigest(),
+        source=source,
+        model_source=str(model_path),
+        seed=doc.sampling.seed,
+    )
+
+
+def load_study(path: str | os.PathLike[str]) -> Study:
+    """Read and validate a study file (TOML, ``schema_version = 1``).
+
+    Raises
+    ------
+    ModelError
+        One line naming the field, the value and the rule; nothing has run and nothing is written.
+    """
+    p = Path(path)
+    data = read_toml(p, "study file")
+    text = p.read_text(encoding="utf-8")
+    return study_from_dict(data, p.parent, source=str(p), text=text)
+
+
+def describe(study: Study) -> dict[str, Any]:
+    """A short JSON-able description of the study (for store attributes and summaries)."""
+    return {
+        "name": study.name,
+        "sampling": study.method,
+        "parameters": [p.name for p in study.parameters],
+        "dims": list(study.dims),
+        "shape": list(study.shape),
+        "designs": study.size,
+        "outputs": list(study.outputs),
+        "seed": study.seed,
+    }

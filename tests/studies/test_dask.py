@@ -1,0 +1,36 @@
+"""Studies on dask.distributed clusters equal the in-process run."""
+
+import logging
+
+import pytest
+from _study_helpers import GRID_6x5, write_study
+
+from impstab.cli import main
+from impstab.studies import load_study, open_study, run_study
+
+distributed = pytest.importorskip("distributed")
+
+
+def _values(store):
+    return open_study(store).dataset.drop_attrs()
+
+
+def test_local_cluster_of_worker_processes_equals_in_process(tmp_path, capsys):
+    path = write_study(tmp_path, GRID_6x5, chunk_size=5)
+    run_study(load_study(path), tmp_path / "local.zarr")
+    code = main(["sweep", str(path), "-o", str(tmp_path / "dask.zarr"), "--workers", "2", "--no-progress"])
+    assert code == 0, capsys.readouterr().err
+    assert _values(tmp_path / "dask.zarr").identical(_values(tmp_path / "local.zarr"))
+    history = open_study(tmp_path / "dask.zarr").dataset.attrs["history"]
+    assert "local cluster of 2 workers" in history
+
+
+def test_existing_scheduler_by_address(tmp_path, capsys):
+    path = write_study(tmp_path, GRID_6x5, chunk_size=10)
+    run_study(load_study(path), tmp_path / "local.zarr")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
+                                  silence_logs=logging.ERROR) as cluster:
+        code = main(["sweep", str(path), "-o", str(tmp_path / "remote.zarr"), "--scheduler", cluster.scheduler_address,
+                     "--no-progress"])
+    assert code == 0, capsys.readouterr().err
+    assert _values(tmp_path / "remote.zarr").identical(_values(tmp_path / "local.zarr"))
