@@ -48,8 +48,8 @@ def print_json(obj: dict) -> None:
 def run_guarded(command: click.Command, argv: list[str] | None) -> int:
     """Run a click command, mapping errors to one-line messages and exit codes."""
     try:
-        command.main(args=argv, prog_name="impstab", standalone_mode=False)
-        return 0
+        # outside standalone mode click returns ctx.exit(n)'s code instead of raising it
+        return int(command.main(args=argv, prog_name="impstab", standalone_mode=False) or 0)
     except ModelError as exc:
         click.echo(f"impstab: error: {exc}", err=True)
         return 2

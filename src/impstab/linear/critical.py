@@ -277,7 +277,10 @@ class _Engine:
         The projector is oblique (``V_C W_C^H`` with left eigenvectors ``W^H = V^-1``): for a
         non-normal problem the right eigenvectors of other clusters are not orthogonal to it.
         """
-        inv = np.linalg.inv(vecs)
+        try:
+            inv = np.linalg.inv(vecs)
+        except np.linalg.LinAlgError:  # an exactly defective point: use the pseudo-inverse
+            inv = np.linalg.pinv(vecs)
         return vecs[:, members], inv[members, :]
 
     @staticmethod
@@ -416,7 +419,10 @@ class _Engine:
                 f = _pair_growth(v) - target * abs(v[j])
             if not derivative:
                 return float(f)
-            w = np.linalg.inv(vecs)[sel, :]
+            try:
+                w = np.linalg.inv(vecs)[sel, :]
+            except np.linalg.LinAlgError:  # eigenvectors exactly dependent: no derivative here
+                raise _Ambiguous from None
             b = np.einsum("ij,jk,ki->i", w, self.ops[1], vecs[:, sel])
             if self.undamped:
                 df = b.real.mean() if divergence else (2 * k * (v * b).sum() - 2 * v.sum() * b.sum()).real
