@@ -3,12 +3,24 @@
 from __future__ import annotations
 
 import numpy as np
-from conftest import ring_model_dict
 
 
 def symmetric() -> dict:
-    """The symmetric three-mount ring of ``examples/imp_symmetric.toml`` (T_c about 18012 N)."""
-    return ring_model_dict()
+    """The symmetric three-mount ring of ``examples/imp_symmetric.toml`` (T_c about 18012 N).
+
+    Written out rather than imported from ``tests/conftest.py``: a subprocess test imports this
+    module with only this folder on its path.
+    """
+    return {
+        "schema_version": 1,
+        "name": "ring",
+        "body": {"mass": 100.0, "inertia": [1.0, 6.0, 6.0]},
+        "mount_rings": [
+            {"count": 3, "radius": 0.15, "x": 0.3, "start_angle": 90.0, "k_axial": 1.0e5, "k_shear": 2.0e4}
+        ],
+        "thrust": {"operating": 2000.0},
+        "analysis": {"thrust_max": 30000.0},
+    }
 
 
 def asymmetric(damped: bool = False, gyro: bool = False, tangency: float = 1.0) -> dict:
