@@ -25,6 +25,9 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/critical.py
+	$(PY) benchmarks/fluid.py
+	$(PY) benchmarks/simulate.py
+	$(PY) benchmarks/sweep.py
 
 clean:
 	rm -rf $(VENV) demo-locus.nc demo-locus.png

@@ -25,7 +25,7 @@ except _metadata.PackageNotFoundError:  # pragma: no cover - running from a sour
 
 __all__ = [
     "__version__", "load_model", "Model", "linearize", "LinearSystem", "modes", "critical_thrust",
-    "locus", "simulate", "critical_load", "fluid", "ModelError", "NumericalError", "DOF_NAMES",
+    "locus", "simulate", "critical_load", "modal_form", "load_study", "run_study", "open_study", "fluid", "ModelError", "NumericalError", "DOF_NAMES",
 ]
 
 _LAZY = {
@@ -34,6 +34,9 @@ _LAZY = {
     "locus": ("linear.locus", "locus"),
     "modal_form": ("linear.modal_form", "modal_form"),
     "simulate": ("dynamics.simulate", "simulate"),
+    "load_study": ("studies", "load_study"),
+    "run_study": ("studies", "run_study"),
+    "open_study": ("studies", "open_study"),
 }
 
 

@@ -54,7 +54,9 @@ def plot_simulation(result, ax=None):
     ax_s.set_title(f"{result.model_name}: {_label(result)}", fontsize="medium")
     note = _growth_note(result)
     if not result.completed:
-        note = (note + "\n" if note else "") + f"stopped: {result.stop_reason}"
+        import textwrap
+
+        note = (note + "\n" if note else "") + textwrap.fill(f"stopped: {result.stop_reason}", 48)
     if note:
         ax_s.text(0.01, 0.98, note, transform=ax_s.transAxes, va="top", fontsize="x-small",
                   bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none"})
