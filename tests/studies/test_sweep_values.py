@@ -11,7 +11,7 @@ from conftest import asymmetric_model_dict
 import impstab
 from impstab.cli import main
 from impstab.errors import NumericalError
-from impstab.linear import batch
+from impstab.linear.batch import api as batch  # the module that builds the families
 from impstab.linear.batch import STATUSES, critical_thrust_batch
 from impstab.model import model_from_dict
 from impstab.model.assemble import read_toml

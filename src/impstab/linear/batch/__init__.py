@@ -1,0 +1,28 @@
+"""Critical thrust of many models at once (design studies).
+
+The steps of the engine in :mod:`impstab.linear.critical` are run for all designs together:
+
+1. the thrust scan: the grid operators of all designs (``M^-1 K`` or the state matrix,
+   THEORY 5) are classified in a few stacked LAPACK calls, with the engine's own classification
+   (same tolerances, same bubble indicators), chunk by chunk, each design stopping where its
+   scan would;
+2. the bracket logic of the scan, vectorized across designs; the bubble searches (scipy's
+   bounded Brent minimisation, which the engine uses, ported step for step) run in lockstep so
+   that each step is one stacked classification; the ``attracting`` test is vectorized for
+   affine undamped designs;
+3. the exact refinement, vectorized for affine undamped designs (the common case: symmetric
+   layouts, or the classical linearization): the root of the cluster discriminant by bracketed
+   Newton steps to machine precision. Any design that leaves this path (an ambiguous cluster, no
+   sign change of the indicator, unstable at zero thrust), and every damped, gyroscopic or
+   rotating-equilibrium design, is refined by its own engine, exactly as in
+   :func:`impstab.critical_thrust`.
+
+The values agree with :func:`impstab.critical_thrust` to rounding. A design with compressible
+fluid loading goes through :func:`impstab.critical_thrust` itself. Failures are per design: a
+model whose analysis raises gets a status and a message.
+"""
+
+from .api import critical_thrust_batch
+from .jobs import KINDS, STATUSES, BatchCriticalThrust
+
+__all__ = ["BatchCriticalThrust", "critical_thrust_batch", "KINDS", "STATUSES"]

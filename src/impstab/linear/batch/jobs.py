@@ -1,0 +1,126 @@
+"""Per-design jobs of a batched critical-thrust evaluation, and the result type."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..critical import _Engine
+from ..linearize import ModelFamily
+
+Array = NDArray[np.float64]
+
+#: kind codes: index in this tuple (-1: not available)
+KINDS = ("none", "flutter", "divergence")
+#: status codes: index in this tuple (-1: not computed)
+STATUSES = ("ok", "invalid", "numerical_failure", "error")
+_EPS4 = 4 * np.finfo(float).eps
+
+
+@dataclass(frozen=True, eq=False)
+class BatchCriticalThrust:
+    """Critical thrusts of a batch of designs, one entry per design.
+
+    Attributes
+    ----------
+    thrust, omega : (N,) float arrays
+        Critical thrust (N) and angular frequency at onset (rad/s); NaN when the design has none
+        up to its ``thrust_max`` or failed.
+    kind, undamped_kind : (N,) int8 arrays
+        Codes into :data:`KINDS`; -1 for a failed design.
+    undamped_thrust : (N,) float array
+        Critical thrust with every damper removed (N).
+    thrust_max, operating : (N,) float arrays
+        Search range end and operating thrust (N; NaN without one).
+    modes : list of str
+        Dofs with at least 5 % of the kinetic energy of the critical mode, comma-separated.
+    status : (N,) int8 array
+        Codes into :data:`STATUSES`.
+    message : list of str
+        Empty when ``status`` is 0, else a one-line reason.
+    evaluations : int
+        Eigenproblems solved in total.
+    """
+
+    thrust: Array
+    kind: NDArray[np.int8]
+    omega: Array
+    undamped_thrust: Array
+    undamped_kind: NDArray[np.int8]
+    thrust_max: Array
+    operating: Array
+    modes: list[str]
+    status: NDArray[np.int8]
+    message: list[str]
+    evaluations: int = 0
+
+    @property
+    def frequency_hz(self) -> Array:
+        """Onset frequency ``omega / 2 pi`` (Hz)."""
+        return self.omega / (2.0 * np.pi)
+
+    @property
+    def margin(self) -> Array:
+        """``critical / operating`` (NaN without either)."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return self.thrust / self.operating
+
+
+class _PrimedEngine(_Engine):
+    """An engine whose scan chunks were classified beforehand, in a batch with other designs."""
+
+    def __init__(self, family: ModelFamily, p_max: float, primed: dict) -> None:
+        super().__init__(family, p_max)
+        self.primed = primed
+
+    def classify(self, p: Array):
+        hit = self.primed.get((float(p[0]), len(p))) if len(p) else None
+        if hit is not None:  # counted by the job that classified it
+            return hit
+        return super().classify(p)
+
+
+class _Stack(_Engine):
+    """The engine's classification applied to a ready stack of operators (no engine set-up)."""
+
+    def __init__(self, ops: Array | None, undamped: bool) -> None:  # noqa: D107
+        self._ops = ops
+        self.undamped = undamped
+        self.evaluations = 0
+
+    def operators(self, p: Array):
+        return self._ops, None
+
+
+class _Job:
+    """One critical-load search: a design, or the undamped companion of a damped design."""
+
+    def __init__(self, family: ModelFamily, p_max: float, n_scan: int) -> None:
+        self.family, self.p_max = family, p_max
+        self.grid = np.linspace(0.0, p_max, n_scan + 1)
+        self.primed: dict = {}
+        self.flags: list = []
+        self.ind: list = []
+        self.evaluations = 0
+        self._engine: _PrimedEngine | None = None
+        parts = family.affine_parts()
+        self.fast = parts is not None and not (np.any(parts[1] != 0) or np.any(parts[2] != 0))
+        if self.fast:  # M^-1 K0 and M^-1 K1 are formed for all jobs at once (_operators)
+            self.mass, self.k0, self.k1 = np.array(parts[0]), parts[3], parts[4]
+        self.undamped = True if self.fast else self.engine().undamped
+
+    def engine(self) -> _PrimedEngine:
+        if self._engine is None:
+            self._engine = _PrimedEngine(self.family, self.p_max, self.primed)
+        return self._engine
+
+    def point_op(self, x: float) -> Array:
+        """The eigen-operator at one load, as the engine forms it."""
+        if self.fast:
+            return self.a0[None] + np.array([x])[:, None, None] * self.a1[None]
+        return self.engine().operators(np.array([x]))[0]
+
+
+# -- batched scan -----------------------------------------------------------------------------

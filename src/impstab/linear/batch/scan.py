@@ -1,0 +1,281 @@
+"""The batched thrust scan: stacked classification, brackets, bubble searches."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..critical import TOL_DUPLICATE, TOL_UNSTABLE
+from .jobs import _Job, _Stack
+
+Array = NDArray[np.float64]
+
+
+
+def _operators(jobs: list[_Job]) -> None:
+    """``a0 = M^-1 K0`` and ``a1 = M^-1 K1`` of the affine undamped jobs, as the engine forms them."""
+    fast = [j for j in jobs if j.fast]
+    if not fast:
+        return
+    m = np.stack([j.mass for j in fast])
+    a = np.linalg.solve(np.concatenate([m, m]), np.concatenate([np.stack([j.k0 for j in fast]), np.stack([j.k1 for j in fast])]))
+    for i, j in enumerate(fast):
+        j.a0, j.a1 = a[i], a[len(fast) + i]
+
+
+def _classify_group(jobs: list[_Job], start: int, stop: int) -> list:
+    if jobs[0].fast:
+        a0 = np.stack([j.a0 for j in jobs])
+        a1 = np.stack([j.a1 for j in jobs])
+        p = np.stack([j.grid[start:stop] for j in jobs])
+        ops = a0[:, None] + p[:, :, None, None] * a1[:, None]
+    else:
+        ops = np.stack([j.engine().operators(j.grid[start:stop])[0] for j in jobs])
+    flat = ops.reshape((-1,) + ops.shape[2:])
+    try:
+        flags, ind = _Stack(flat, jobs[0].undamped).classify(np.zeros(len(flat)))
+    except np.linalg.LinAlgError:
+        out = []
+        for j in jobs:
+            try:
+                out.append(_Stack(j.engine().operators(j.grid[start:stop])[0], j.undamped).classify(j.grid[start:stop]))
+            except Exception as exc:  # noqa: BLE001 - reported per design
+                out.append(exc)
+        return out
+    n = stop - start
+    return [(flags[i * n:(i + 1) * n], ind[i * n:(i + 1) * n]) for i in range(len(jobs))]
+
+
+def _prime(jobs: list[_Job], chunk: int, errors: dict) -> None:
+    """Classify each job's scan grid chunk by chunk, batched; a job stops where its scan would."""
+    n_pts = len(jobs[0].grid) if jobs else 0
+    first = {id(j): n_pts for j in jobs}
+    active, start = list(jobs), 0
+    while active and start < n_pts:
+        stop = min(start + chunk, n_pts)
+        for key in {(j.fast, j.undamped) for j in active}:
+            group = [j for j in active if (j.fast, j.undamped) == key]
+            for j, r in zip(group, _classify_group(group, start, stop)):
+                if isinstance(r, Exception):
+                    errors[id(j)] = r
+                    continue
+                j.primed[(float(j.grid[start]), stop - start)] = r
+                j.flags.append(r[0])
+                j.ind.append(r[1])
+                j.evaluations += stop - start
+                bad = np.flatnonzero(r[0])
+                if bad.size and first[id(j)] == n_pts:
+                    first[id(j)] = start + int(bad[0])
+        active = [j for j in active if id(j) not in errors and first[id(j)] >= stop - 1]
+        start = stop
+
+
+# -- vectorized engine steps -----------------------------------------------------------------
+def _brackets(jobs: list[_Job], errors: dict) -> list:
+    """First bracket of each job's scan as the engine's ``scan`` finds it (None: no crossing).
+
+    The bubble searches of all jobs run in lockstep; the ``attracting`` test is vectorized for
+    affine undamped jobs and the engine's own for the others (always true when damped).
+    """
+    n_pts = len(jobs[0].grid)
+    flags = np.zeros((len(jobs), n_pts), dtype=bool)
+    ind = np.full((len(jobs), n_pts, 2), np.nan)
+    length = np.array([sum(len(f) for f in j.flags) for j in jobs])
+    for r, j in enumerate(jobs):
+        flags[r, : length[r]] = np.concatenate(j.flags)
+        ind[r, : length[r]] = np.concatenate(j.ind)
+    js = np.arange(n_pts)[None, :]
+    upper = np.where(length < n_pts, length - 1, n_pts)[:, None]
+    valid = (js >= 1) & (js < upper)
+    prev = np.roll(flags, 1, axis=1)
+    nxt_i = np.minimum(js + 1, length[:, None] - 1)
+    nxt_f = np.take_along_axis(flags, nxt_i, axis=1)
+    inner = ~flags & (js + 1 < length[:, None]) & ~nxt_f
+    prev_ind, nxt_ind = np.roll(ind, 1, axis=1), np.take_along_axis(ind, nxt_i[..., None].repeat(2, -1), axis=1)
+    with np.errstate(invalid="ignore"):
+        dips = inner[..., None] & (ind < prev_ind) & (ind <= nxt_ind)
+    change = flags != prev
+    cand = valid & (change | dips[..., 0] | dips[..., 1])
+    out: list = [None] * len(jobs)
+    pos = {r: 0 for r in range(len(jobs))}
+    while pos:
+        dip: list[tuple[int, int]] = []
+        for r in list(pos):
+            hits = np.flatnonzero(cand[r, pos[r]:])
+            if not hits.size:
+                del pos[r]
+                continue
+            j = pos[r] + int(hits[0])
+            pos[r] = j + 1
+            if change[r, j]:
+                out[r] = (jobs[r].grid[j - 1], jobs[r].grid[j])
+                del pos[r]
+            else:
+                dip.append((r, j))
+        # a dip of the smallest s first, then a close approach of two frequencies that attract
+        first = _bubbles(jobs, [(r, j) for r, j in dip if dips[r, j, 1] and jobs[r].undamped], 1, errors)
+        rest = [(r, j) for r, j in dip if first.get(r) is None and dips[r, j, 0] and id(jobs[r]) not in errors]
+        attract = _attract_any(jobs, rest, errors)
+        second = _bubbles(jobs, [rj for rj in rest if attract.get(rj[0])], 0, errors)
+        for r, j in dip:
+            if id(jobs[r]) in errors:
+                del pos[r]
+                continue
+            hit = first.get(r) if first.get(r) is not None else second.get(r)
+            if hit is not None:
+                out[r] = (jobs[r].grid[j - 1], hit)
+                del pos[r]
+    return out
+
+
+def _attract_any(jobs: list[_Job], where: list[tuple[int, int]], errors: dict) -> dict[int, bool]:
+    """The engine's ``attracting`` test for each (job, grid index)."""
+    out: dict[int, bool] = {}
+    fast = [(r, j) for r, j in where if jobs[r].fast]
+    if fast:
+        out.update(zip([r for r, _ in fast], _attracting([jobs[r] for r, _ in fast], [j for _, j in fast])))
+    for r, j in where:
+        if jobs[r].fast:
+            continue
+        g = jobs[r].grid
+        try:
+            out[r] = jobs[r].engine().attracting(g[j - 1], g[j], g[j + 1])
+        except Exception as exc:  # noqa: BLE001 - reported per design
+            errors[id(jobs[r])] = exc
+    return out
+
+
+def _bubbles(jobs: list[_Job], where: list[tuple[int, int]], column: int, errors: dict) -> dict:
+    """The engine's ``bubble(grid[j-1], grid[j+1], column)`` for many jobs, in lockstep.
+
+    Each search is scipy's bounded Brent minimisation (the engine's), ported step for step to a
+    generator, so that all searches share one batched classification per step.
+    """
+    found: dict[int, float | None] = {}
+    runs = {}
+    for r, j in where:
+        lo, hi = jobs[r].grid[j - 1], jobs[r].grid[j + 1]
+        gen = _bounded_minimum(lo, hi, (hi - lo) * 1e-9)
+        runs[r] = (gen, next(gen))
+        found[r] = None
+    while runs:
+        step: dict[bool, list] = {}
+        for r in list(runs):
+            try:
+                step.setdefault(jobs[r].undamped, []).append((r, jobs[r].point_op(runs[r][1])))
+            except Exception as exc:  # noqa: BLE001 - reported per design
+                errors[id(jobs[r])] = exc
+                del runs[r]
+        for undamped, items in step.items():
+            ops = np.concatenate([op for _, op in items])
+            unstable, ind = _Stack(ops, undamped).classify(np.zeros(len(ops)))
+            for k, (r, _) in enumerate(items):
+                jobs[r].evaluations += 1
+                gen, x = runs.pop(r)
+                if unstable[k]:
+                    found[r] = float(x)
+                    continue
+                try:
+                    runs[r] = (gen, gen.send(float(ind[k, column])))
+                except StopIteration:
+                    pass
+    return found
+
+
+def _bounded_minimum(x1: float, x2: float, xatol: float, maxfun: int = 500):
+    """scipy's ``_minimize_scalar_bounded`` as a generator: yields x, receives f(x)."""
+    sqrt_eps = np.sqrt(2.2e-16)
+    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))
+    a, b = x1, x2
+    fulc = a + golden_mean * (b - a)
+    nfc, xf = fulc, fulc
+    rat = e = 0.0
+    fx = yield xf
+    num = 1
+    ffulc = fnfc = fx
+    xm = 0.5 * (a + b)
+    tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
+    tol2 = 2.0 * tol1
+    while np.abs(xf - xm) > (tol2 - 0.5 * (b - a)):
+        golden = 1
+        if np.abs(e) > tol1:  # parabolic fit
+            golden = 0
+            r = (xf - nfc) * (fx - ffulc)
+            q = (xf - fulc) * (fx - fnfc)
+            p = (xf - fulc) * q - (xf - nfc) * r
+            q = 2.0 * (q - r)
+            if q > 0.0:
+                p = -p
+            q = np.abs(q)
+            r = e
+            e = rat
+            if (np.abs(p) < np.abs(0.5 * q * r)) and (p > q * (a - xf)) and (p < q * (b - xf)):
+                rat = (p + 0.0) / q
+                x = xf + rat
+                if ((x - a) < tol2) or ((b - x) < tol2):
+                    rat = tol1 * (np.sign(xm - xf) + ((xm - xf) == 0))
+            else:
+                golden = 1
+        if golden:
+            e = a - xf if xf >= xm else b - xf
+            rat = golden_mean * e
+        si = np.sign(rat) + (rat == 0)
+        x = xf + si * np.maximum(np.abs(rat), tol1)
+        fu = yield x
+        num += 1
+        if fu <= fx:
+            if x >= xf:
+                a = xf
+            else:
+                b = xf
+            fulc, ffulc = nfc, fnfc
+            nfc, fnfc = xf, fx
+            xf, fx = x, fu
+        else:
+            if x < xf:
+                a = x
+            else:
+                b = x
+            if (fu <= fnfc) or (nfc == xf):
+                fulc, ffulc = nfc, fnfc
+                nfc, fnfc = x, fu
+            elif (fu <= ffulc) or (fulc == xf) or (fulc == nfc):
+                fulc, ffulc = x, fu
+        xm = 0.5 * (a + b)
+        tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
+        tol2 = 2.0 * tol1
+        if num >= maxfun:
+            return
+
+
+def _attracting(jobs: list[_Job], js: list[int]) -> NDArray[np.bool_]:
+    """The engine's ``attracting(grid[j-1], grid[j], grid[j+1])`` for many jobs at once."""
+    lo = np.array([jb.grid[j - 1] for jb, j in zip(jobs, js)])
+    mid = np.array([jb.grid[j] for jb, j in zip(jobs, js)])
+    hi = np.array([jb.grid[j + 1] for jb, j in zip(jobs, js)])
+    a0, a1 = np.stack([jb.a0 for jb in jobs]), np.stack([jb.a1 for jb in jobs])
+    for jb in jobs:
+        jb.evaluations += 3
+    op = lambda p: a0 + p[:, None, None] * a1  # noqa: E731
+    vals, vecs = np.linalg.eig(op(mid))
+    vals, vecs = vals.astype(complex), vecs.astype(complex)
+    result = np.abs(vals.imag).max(-1) > TOL_UNSTABLE * np.abs(vals).max(-1)
+    order = np.argsort(vals.real, axis=-1)
+    re = np.take_along_axis(vals.real, order, -1)
+    scale = np.abs(re).max(-1, keepdims=True)
+    diffs = np.diff(re, axis=-1)
+    distinct = diffs >= TOL_DUPLICATE * scale
+    j = np.argmin(np.where(distinct, diffs, np.inf), axis=-1)
+    pick = lambda c: np.take_along_axis(re, c[:, None], -1)  # noqa: E731
+    lower_s, upper_s = np.abs(re - pick(j)) < TOL_DUPLICATE * scale, np.abs(re - pick(j + 1)) < TOL_DUPLICATE * scale
+    lower, upper = np.zeros_like(lower_s), np.zeros_like(upper_s)
+    np.put_along_axis(lower, order, lower_s, -1)
+    np.put_along_axis(upper, order, upper_s, -1)
+    rate = (op(hi) - op(lo)) / (hi - lo)[:, None, None]
+    b = np.linalg.solve(vecs, rate.astype(complex) @ vecs)
+    blu = b * (lower[:, :, None] & upper[:, None, :])
+    bul = b * (upper[:, :, None] & lower[:, None, :])
+    inter = np.linalg.eigvals(blu @ bul)
+    norm = np.maximum(np.abs(rate).max(axis=(-2, -1)), 1e-300)
+    pulled = np.any(inter.real < -1e-8 * norm[:, None] ** 2, axis=-1)
+    return np.where(result, True, distinct.any(-1) & pulled)
