@@ -11,7 +11,7 @@ import click
 
 from ..errors import ModelError, NumericalError
 
-__all__ = ["run_guarded", "print_json", "jsonable", "BadInput"]
+__all__ = ["run_guarded", "print_json", "jsonable", "BadInput", "console", "check_number"]
 
 
 class BadInput(click.ClickException):
@@ -38,6 +38,26 @@ def jsonable(value: Any) -> Any:
     if isinstance(value, np.bool_):
         return bool(value)
     return value
+
+
+def console(stderr: bool = False):
+    """A rich console; piped or redirected output is 160 columns wide so tables do not wrap."""
+    from rich.console import Console
+
+    stream = sys.stderr if stderr else sys.stdout
+    return Console(highlight=False, width=None if stream.isatty() else 160, stderr=stderr)
+
+
+def check_number(field: str, value: float | None, positive: bool = False, nonneg: bool = False) -> None:
+    """Reject a non-finite (or, as asked, non-positive / negative) command-line number."""
+    if value is None:
+        return
+    if not math.isfinite(value):
+        raise ModelError(field, value, "must be a finite number")
+    if positive and value <= 0:
+        raise ModelError(field, value, "must be > 0")
+    if nonneg and value < 0:
+        raise ModelError(field, value, "must be >= 0")
 
 
 def print_json(obj: dict) -> None:

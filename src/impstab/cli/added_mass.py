@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import sys
 from typing import Any
 
 import click
 import numpy as np
 
 from ..errors import ModelError
-from ._common import print_json
+from ._common import console, print_json
 
 __all__ = ["commands", "parse_frequencies"]
 
@@ -32,14 +31,6 @@ def parse_frequencies(spec: str) -> np.ndarray:
     if num == 1 and start != stop:
         raise ModelError("--frequencies", spec, "NUM = 1 needs START = STOP")
     return np.linspace(start, stop, num)
-
-
-def _console(stderr: bool = False):
-    from rich.console import Console
-
-    stream = sys.stderr if stderr else sys.stdout
-    width = None if stream.isatty() else 160
-    return Console(highlight=False, width=width, stderr=stderr)
 
 
 def _fmt(x: float | None, digits: int = 6) -> str:
@@ -77,7 +68,7 @@ def _point_table(r) -> None:
     )
     for label, value, unit in rows:
         table.add_row(label, "incompressible" if value is None and "sound" in label else _fmt(value), unit)
-    _console().print(table)
+    console().print(table)
 
 
 def _sweep_table(sweep) -> None:
@@ -93,15 +84,15 @@ def _sweep_table(sweep) -> None:
         table.add_row(*(_fmt(v) for v in (
             p.frequency, p.added_mass, p.strip_ratio, p.added_inertia, p.inertia_strip_ratio,
             p.radiation_resistance, p.rotational_radiation_resistance, p.loss_factor)))
-    _console().print(table)
+    console().print(table)
 
 
 def _progress(values):
     from rich.progress import track
 
-    console = _console(stderr=True)
-    return track(values, description="frequencies", console=console, transient=True,
-                 disable=not console.is_terminal or len(values) < 20)
+    err = console(stderr=True)
+    return track(values, description="frequencies", console=err, transient=True,
+                 disable=not err.is_terminal or len(values) < 20)
 
 
 @click.command("added-mass")

@@ -8,38 +8,17 @@ import click
 import numpy as np
 
 from ..errors import ModelError
-from ._common import print_json
+from ._common import check_number, console, print_json
 
 __all__ = ["commands"]
 
 LINEARIZATION = click.Choice(["equilibrium", "classical"])
 
 
-def _console():
-    import sys
-
-    from rich.console import Console
-
-    # a table piped to a file or pasted elsewhere should not wrap at 80 columns
-    width = None if sys.stdout.isatty() else 160
-    return Console(highlight=False, width=width)
-
-
 def _load(path: str):
     from ..model import load_model
 
     return load_model(path)
-
-
-def _finite(name: str, value: float | None, positive: bool = False, nonneg: bool = False) -> None:
-    if value is None:
-        return
-    if not np.isfinite(value):
-        raise ModelError(name, value, "must be a finite number")
-    if positive and value <= 0:
-        raise ModelError(name, value, "must be > 0")
-    if nonneg and value < 0:
-        raise ModelError(name, value, "must be >= 0")
 
 
 def _fmt(x: float | None, unit: str = "", digits: int = 6) -> str:
@@ -58,7 +37,7 @@ def check_cmd(model_file: str) -> None:
     from ..model.model import DOF_NAMES
 
     model = _load(model_file)
-    con = _console()
+    con = console()
     b = model.body
     con.print(f"[bold]{model.name}[/bold]  ({model_file}): valid, schema_version 1")
     t = Table(title="assembled model", show_header=True)
@@ -109,7 +88,7 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
     from ..linear.modes import modes
     from ..model.model import DOF_NAMES
 
-    _finite("--thrust", thrust, nonneg=True)
+    check_number("--thrust", thrust, nonneg=True)
     model = _load(model_file)
     res = modes(model, thrust, linearization)
     if as_json:
@@ -125,7 +104,7 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
             str(j + 1), f"{res.frequency_hz[j]:.6g}", f"{res.omega[j]:.6g}", f"{res.damping_ratio[j]:.4g}",
             f"{res.growth_rate[j]:.4g}", ", ".join(dom), *(f"{abs(v):.3f}" for v in res.shapes[:, j]),
         )
-    con = _console()
+    con = console()
     con.print(t)
     con.print("shapes: displacement of A (m) and rotation (rad), largest component 1; "
               + ("stable" if res.stable else "[red]UNSTABLE[/red]"))
@@ -143,7 +122,7 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
     from ..linear.critical_thrust import critical_thrust
     from ..linear.locus import locus
 
-    _finite("--thrust-max", thrust_max, positive=True)
+    check_number("--thrust-max", thrust_max, positive=True)
     if steps < 1 or steps > 100000:
         raise ModelError("--steps", steps, "must be between 1 and 100000")
     if output is not None and Path(output).suffix.lower() not in (".nc", ".png"):
@@ -160,7 +139,7 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
         with atomic_path(out) as tmp:
             res.to_xarray().to_netcdf(tmp, engine="h5netcdf")
     _save_png(res, png)
-    con = _console()
+    con = console()
     con.print(f"critical thrust: {_fmt(crit.thrust, 'N')} ({crit.kind})")
     if out.suffix.lower() == ".nc":
         con.print(f"wrote {out} and {png}")
@@ -195,7 +174,7 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
 
     from ..linear.critical_thrust import critical_thrust
 
-    _finite("--thrust-max", thrust_max, positive=True)
+    check_number("--thrust-max", thrust_max, positive=True)
     model = _load(model_file)
     res = critical_thrust(model, thrust_max=thrust_max, linearization=linearization, all_crossings=all_crossings)
     if as_json:
@@ -220,7 +199,7 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
         t.add_row(f"crossing ({c.direction})", f"{c.load:.10g} N, {c.kind}, {c.omega / (2 * np.pi):.6g} Hz")
     if res.fluid_frequency_hz is not None:
         t.add_row("fluid coefficients at", f"{res.fluid_frequency_hz:.6g} Hz ({res.fluid_iterations} iterations, last change {res.fluid_change if res.fluid_change is not None else float('nan'):.2e})")
-    con = _console()
+    con = console()
     con.print(t)
     for w in res.warnings:
         con.print(f"[yellow]warning:[/yellow] {w}")

@@ -10,22 +10,11 @@ from pathlib import Path
 import click
 
 from ..errors import ModelError
-from ._common import print_json
+from ._common import check_number, print_json
 
 __all__ = ["commands"]
 
 INTEGRATOR = click.Choice(["hamming", "gill", "dop853", "rk45", "radau", "lsoda"], case_sensitive=False)
-
-
-def _number(field: str, value: float | None, positive: bool = False, nonneg: bool = False) -> None:
-    if value is None:
-        return
-    if not math.isfinite(value):
-        raise ModelError(field, value, "must be a finite number")
-    if positive and value <= 0:
-        raise ModelError(field, value, "must be > 0")
-    if nonneg and value < 0:
-        raise ModelError(field, value, "must be >= 0")
 
 
 def _thrust_list(thrust: float | None, thrusts: str | None) -> list[float]:
@@ -40,11 +29,11 @@ def _thrust_list(thrust: float | None, thrusts: str | None) -> list[float]:
         if not values:
             raise ModelError("--thrusts", thrusts, "must list at least one thrust")
         for v in values:
-            _number("--thrusts", v, nonneg=True)
+            check_number("--thrusts", v, nonneg=True)
         return values
     if thrust is None:
         raise ModelError("--thrust", None, "give the thrust in N (--thrust T) or several (--thrusts T1,T2,T3)")
-    _number("--thrust", thrust, nonneg=True)
+    check_number("--thrust", thrust, nonneg=True)
     return [thrust]
 
 
@@ -61,7 +50,7 @@ def _dof_values(option: str, items: tuple[str, ...]) -> dict[str, float]:
             v = float(value)
         except ValueError:
             raise ModelError(option, item, "must be DOF=VALUE with a number VALUE") from None
-        _number(option, v)
+        check_number(option, v)
         out[name] = v
     return out
 
@@ -154,10 +143,10 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     from ..model import load_model
 
     values = _thrust_list(thrust, thrusts)
-    _number("--duration", duration, positive=True)
-    _number("--dt", dt, positive=True)
-    _number("--sample", sample, positive=True)
-    _number("--tol", tol, positive=True)
+    check_number("--duration", duration, positive=True)
+    check_number("--dt", dt, positive=True)
+    check_number("--sample", sample, positive=True)
+    check_number("--tol", tol, positive=True)
     out = Path(output) if output else Path(Path(model_file).stem + "-simulation.nc")
     if out.suffix.lower() not in (".nc", ".csv"):
         raise ModelError("--output", output, "must end in .nc (netCDF) or .csv; a PNG is written beside it")

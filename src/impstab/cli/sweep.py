@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from ..errors import ModelError
+from ._common import console
 
 __all__ = ["commands"]
 
@@ -19,12 +20,6 @@ class Interrupted(click.ClickException):
     """The study was interrupted (Ctrl-C); what was finished is kept (exit code 130)."""
 
     exit_code = 130
-
-
-def _console():
-    from rich.console import Console
-
-    return Console(highlight=False, width=None if sys.stdout.isatty() else 160)
 
 
 def _fmt(v, unit: str = "") -> str:
@@ -94,7 +89,7 @@ def _summary(res, study, out: Path, elapsed: float, written: list[str]) -> None:
     t.add_row("store", str(out))
     for w in written:
         t.add_row("exported", w)
-    _console().print(t)
+    console().print(t)
     failed = res.dataset["status"].values > 0
     if failed.any():
         first = res.dataset["message"].values[failed][0]
@@ -140,7 +135,7 @@ def map_cmd(store: str, x: str | None, y: str | None, value: str, at: tuple[str,
     with atomic_path(out) as tmp:
         ax.figure.savefig(tmp, format="png", dpi=130)
     plt.close(ax.figure)
-    _console().print(f"wrote {out}")
+    console().print(f"wrote {out}")
 
 
 commands = [sweep_cmd, map_cmd]
