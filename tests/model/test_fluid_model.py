@@ -77,8 +77,6 @@ def test_compressible_coefficients_are_taken_at_the_onset_frequency():
 
 
 def test_check_prints_coefficients(capsys, tmp_path):
-    import tomllib  # noqa: F401 - the example file is TOML
-
     from impstab.cli import main
 
     code = main(["check", "examples/imp_fluid.toml"])

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _jinv_coeffs, _log_so3, _skew  # noqa: F401
+from .so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _skew
 
 __all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "MAX_PREDICTOR"]
 
