@@ -32,6 +32,7 @@ from scipy import optimize
 
 from .eigen import kinetic_shares, state_matrices
 from .families import CallableFamily, LinearFamily, SystemFamily
+from .small_eig import eigvals_small
 
 __all__ = ["CriticalLoad", "Crossing", "critical_load", "critical_load_family"]
 
@@ -202,7 +203,7 @@ class _Engine:
         return grow & ~real, grow & real
 
     def _classify_ops(self, ops: Array) -> tuple[Array, Array]:
-        vals = np.linalg.eigvals(ops)
+        vals = eigvals_small(ops)
         cplx, neg = self.unstable_parts(vals)
         unstable = (cplx | neg).any(axis=-1)
         mag = np.maximum(np.abs(vals), 1e-300)
