@@ -15,9 +15,9 @@ from numpy.typing import NDArray
 from ..errors import ModelError, NumericalError
 from ..model.model import LINEARIZATIONS, Model
 from .system import LinearSystem
-from .tangent import linearize_batch
+from .tangent import classical_pairs, linearize_batch
 
-__all__ = ["linearize", "ModelFamily", "PackedModel", "pack_model"]
+__all__ = ["linearize", "ModelFamily", "PackedModel", "pack_model", "affine_forms"]
 
 Array = NDArray[np.float64]
 
@@ -82,6 +82,42 @@ def pack_model(model: Model, damped: bool = True, fluid_frequency: float = 0.0) 
     )
 
 
+def affine_forms(
+    mass6: Array, damp6: Array, positions: Array, stiffness: Array, damping: Array, e_dir: Array,
+    r_thrust: Array, tangency: Array, preload: bool, length_scale: Array, equilibrium: bool,
+):
+    """The affine form ``K = K0 + T K1`` of many designs at once (leading design axis ``n``).
+
+    Inputs are :class:`PackedModel` fields stacked over designs (``positions (n, nm, 3)``, ...,
+    ``tangency`` and ``length_scale`` of shape ``(n,)``). Returns ``M, D, K0, K1, G1`` (each
+    ``(n, 6, 6)``; ``G1`` per unit ``I_p Omega``) and ``affine (n,)``: whether K is exactly
+    linear in T for that design.
+
+    The classical form is linear by construction. The equilibrium form is too when linear
+    statics leaves the body unrotated (symmetric layouts, thrust through the elastic centre):
+    then ``R0 = I`` solves the nonlinear statics exactly, the mount forces are the linear ones
+    and the tangent equals the classical matrices.
+    """
+    # K(T) is linear in the classical form: take K1 from a large thrust so that K0 does not
+    # cancel it (the kernel's K is computed linearly in T, so the difference is exact to eps)
+    big = 1e8 * np.maximum(np.abs(stiffness).max(axis=(1, 2, 3), initial=0.0), 1e-300) * length_scale
+    m, d, g, k = classical_pairs(
+        mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency, preload, big, length_scale
+    )
+    k0, k1 = k[:, 0], (k[:, 1] - k[:, 0]) / big[:, None, None]
+    affine = np.ones(len(m), dtype=bool)
+    if equilibrium:
+        e, r = e_dir, r_thrust
+        load = np.stack(
+            [e[:, 0], e[:, 1], e[:, 2], r[:, 1] * e[:, 2] - r[:, 2] * e[:, 1], r[:, 2] * e[:, 0] - r[:, 0] * e[:, 2],
+             r[:, 0] * e[:, 1] - r[:, 1] * e[:, 0]], axis=-1,
+        )
+        q0 = np.linalg.solve(k0, load[..., None])[..., 0]
+        rot = np.abs(q0[:, 3:]).max(axis=-1) * length_scale
+        affine = rot <= 1e-13 * np.maximum(np.abs(q0[:, :3]).max(axis=-1), 1e-300)
+    return m, d, k0, k1, g, affine
+
+
 @dataclass(frozen=True, eq=False)
 class ModelFamily:
     """The model's linearized systems as a function of thrust, evaluated in batches.
@@ -113,27 +149,14 @@ class ModelFamily:
 
     @staticmethod
     def _affine_form(pk: PackedModel, lin: str):
-        """``(M, D, K0, K1, G1, R0-free)`` when K is exactly linear in T, else None.
-
-        The classical form is linear by construction. The equilibrium form is too when linear
-        statics leaves the body unrotated (symmetric layouts, thrust through the elastic centre):
-        then ``R0 = I`` solves the nonlinear statics exactly, the mount forces are the linear
-        ones and the tangent equals the classical matrices.
-        """
-        args = (pk.mass6, pk.damp6, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency,
-                pk.preload, 1.0)
-        # K(T) is linear in the classical form: take K1 from a large thrust so that K0 does not
-        # cancel it (the kernel's K is computed linearly in T, so the difference is exact to eps)
-        big = 1e8 * max(float(np.abs(pk.stiffness).max()), 1e-300) * pk.length_scale
-        m, d, g, k, _, _, _ = linearize_batch(np.array([0.0, big]), np.ones(2), *args, False, pk.length_scale)
-        if lin == "equilibrium":
-            e, r = pk.e_dir, pk.r_thrust
-            load = np.array([e[0], e[1], e[2], r[1] * e[2] - r[2] * e[1], r[2] * e[0] - r[0] * e[2], r[0] * e[1] - r[1] * e[0]])
-            q0 = np.linalg.solve(k[0], load)
-            rot = np.abs(q0[3:]).max() * pk.length_scale
-            if rot > 1e-13 * max(np.abs(q0[:3]).max(), 1e-300):
-                return None
-        return m[0], d[0], k[0], (k[1] - k[0]) / big, g[0]
+        """``(M, D, K0, K1, G1)`` when K is exactly linear in T, else None (see :func:`affine_forms`)."""
+        stack = lambda a: np.asarray(a, dtype=float)[None]  # noqa: E731
+        m, d, k0, k1, g1, affine = affine_forms(
+            stack(pk.mass6), stack(pk.damp6), stack(pk.positions), stack(pk.stiffness), stack(pk.damping),
+            stack(pk.e_dir), stack(pk.r_thrust), stack(pk.tangency), pk.preload, stack(pk.length_scale),
+            lin == "equilibrium",
+        )
+        return (m[0], d[0], k0[0], k1[0], g1[0]) if affine[0] else None
 
     def _affine_matrices(self, p: Array):
         m, d, k0, k1, g1 = self._affine  # type: ignore[attr-defined]

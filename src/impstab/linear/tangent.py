@@ -24,7 +24,7 @@ from numba import njit
 
 from .so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _skew
 
-__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "MAX_PREDICTOR"]
+__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_pairs", "MAX_PREDICTOR"]
 
 #: largest accepted predictor step of the continuation (rad, or fraction of the length scale)
 MAX_PREDICTOR = 0.02
@@ -237,3 +237,30 @@ def linearize_batch(
         u_out[idx] = u
         r_out[idx] = rot
     return m_out, d_out, g_out, k_out, u_out, r_out, ok_out
+
+
+@njit(cache=True)
+def classical_pairs(mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency, preload, big, length_scale):
+    """``linearize_batch`` in the classical form at thrusts ``(0, big[i])`` for each design ``i``.
+
+    Stacked inputs have a leading design axis (``positions (n, nm, 3)``, ...); returns ``M, D,
+    G (n, 6, 6)`` at zero thrust and ``K (n, 2, 6, 6)`` at both thrusts (unit spin, so that G
+    is the gyroscopic matrix per unit ``I_p Omega``).
+    """
+    n = mass6.shape[0]
+    m = np.empty((n, 6, 6))
+    d = np.empty((n, 6, 6))
+    g = np.empty((n, 6, 6))
+    k = np.empty((n, 2, 6, 6))
+    spins = np.ones(2)
+    for i in range(n):
+        thrusts = np.array([0.0, big[i]])
+        mi, di, gi, ki, _, _, _ = linearize_batch(
+            thrusts, spins, mass6[i], damp6[i], positions[i], stiffness[i], damping[i], e_dir[i], r_thrust[i],
+            tangency[i], preload, 1.0, False, length_scale[i],
+        )
+        m[i] = mi[0]
+        d[i] = di[0]
+        g[i] = gi[0]
+        k[i] = ki
+    return m, d, g, k

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from ..linear.kinematics import rigid_map6
 
-__all__ = ["Mount", "axial_shear_matrix", "ring_positions", "elastic_stiffness", "mount_damping"]
+__all__ = ["Mount", "axial_shear_matrix", "ring_positions", "condense", "elastic_stiffness", "mount_damping"]
 
 Array = NDArray[np.float64]
 
@@ -27,11 +27,17 @@ def _frozen(a: Array) -> Array:
     return a
 
 
-def axial_shear_matrix(axis: Array, axial: float, shear: float) -> Array:
-    """``axial a a^T + shear (I - a a^T)`` for a unit axis ``a`` (3 x 3)."""
+def axial_shear_matrix(axis: Array, axial: float | Array, shear: float | Array) -> Array:
+    """``axial a a^T + shear (I - a a^T)`` for a unit axis ``a`` (3 x 3).
+
+    Broadcasts: ``axis (..., 3)`` and ``axial``, ``shear`` of shape ``(...)`` give ``(..., 3, 3)``
+    (a design study assembles all its variants' mounts in one call).
+    """
     a = np.asarray(axis, dtype=float)
-    a = a / np.linalg.norm(a)
-    aa = np.outer(a, a)
+    a = a / np.linalg.norm(a, axis=-1, keepdims=True)
+    aa = a[..., :, None] * a[..., None, :]
+    axial = np.asarray(axial, dtype=float)[..., None, None]
+    shear = np.asarray(shear, dtype=float)[..., None, None]
     return axial * aa + shear * (np.eye(3) - aa)
 
 
@@ -82,18 +88,32 @@ class Mount:
         return bool(np.any(self.stiffness[3:, :] != 0) or np.any(self.stiffness[:, 3:] != 0))
 
 
-def ring_positions(count: int, radius: float, x: float, start_angle_deg: float) -> Array:
-    """Attachment points of ``count`` mounts equally spaced on a ring (angle from +y toward +z)."""
-    ang = np.deg2rad(start_angle_deg) + 2.0 * np.pi * np.arange(count) / count
-    return np.column_stack([np.full(count, float(x)), radius * np.cos(ang), radius * np.sin(ang)])
+def ring_positions(count: int, radius: float | Array, x: float | Array, start_angle_deg: float | Array) -> Array:
+    """Attachment points of ``count`` mounts equally spaced on a ring (angle from +y toward +z).
+
+    Returns ``(count, 3)``; array ``radius``, ``x``, ``start_angle_deg`` of a common shape
+    ``(...)`` give ``(..., count, 3)``.
+    """
+    radius, x, start = (np.asarray(v, dtype=float)[..., None] for v in (radius, x, start_angle_deg))
+    ang = np.deg2rad(start) + 2.0 * np.pi * np.arange(count) / count
+    radius, x, ang = np.broadcast_arrays(radius, x, ang)
+    return np.stack([x, radius * np.cos(ang), radius * np.sin(ang)], axis=-1)
+
+
+def condense(positions: Array, matrices: Array) -> Array:
+    """``sum_i T6_i^T k_i T6_i``: mount matrices at their body ends condensed about A.
+
+    ``positions (..., nm, 3)`` and ``matrices (..., nm, 6, 6)`` give ``(..., 6, 6)`` (leading
+    axes: designs of a study).
+    """
+    t = rigid_map6(np.asarray(positions, dtype=float))
+    return np.einsum("...mji,...mjk,...mkl->...il", t, np.asarray(matrices, dtype=float), t)
 
 
 def _condense(mounts, which: str) -> Array:
-    out = np.zeros((6, 6))
-    for mt in mounts:
-        t = rigid_map6(mt.position)
-        out += t.T @ getattr(mt, which) @ t
-    return out
+    if not mounts:
+        return np.zeros((6, 6))
+    return condense(np.array([m.position for m in mounts]), np.array([getattr(m, which) for m in mounts]))
 
 
 def elastic_stiffness(mounts: tuple[Mount, ...] | list[Mount]) -> Array:

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from ..errors import ModelError
 from ..linear.batch import STATUSES, critical_thrust_batch
 from ..model.assemble import model_from_dict
+from .bulk import assemble_bulk
 from .paths import set_values
 
 __all__ = ["ChunkTask", "ChunkResult", "evaluate_chunk", "variant_dict", "CODE_OUTPUTS"]
@@ -89,9 +90,13 @@ def evaluate_chunk(task: ChunkTask) -> ChunkResult:
     """
     t0 = time.perf_counter()
     n = len(task.columns[0]) if task.columns else 1
+    bulk = assemble_bulk(task.base_model, task.segments, task.columns, task.model_name)
     models: list = []
     errors: dict[int, str] = {}
     for j in range(n):
+        if bulk is not None and bulk.designs[j] is not None:
+            models.append(bulk.designs[j])
+            continue
         d = variant_dict(task.base_model, task.segments, [c[j] for c in task.columns])
         try:
             models.append(model_from_dict(d, name=task.model_name))

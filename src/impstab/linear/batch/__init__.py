@@ -3,7 +3,8 @@
 The steps of the engine in :mod:`impstab.linear.critical` are run for all designs together:
 
 1. the thrust scan: the grid operators of all designs (``M^-1 K`` or the state matrix,
-   THEORY 5) are classified in a few stacked LAPACK calls, with the engine's own classification
+   THEORY 5) are classified in a few stacked calls of the compiled small-matrix eigenvalue
+   routine (:mod:`impstab.linear.small_eig`), with the engine's own classification
    (same tolerances, same bubble indicators), chunk by chunk, each design stopping where its
    scan would;
 2. the bracket logic of the scan, vectorized across designs; the bubble searches (scipy's
@@ -23,6 +24,6 @@ model whose analysis raises gets a status and a message.
 """
 
 from .api import critical_thrust_batch
-from .jobs import KINDS, STATUSES, BatchCriticalThrust
+from .jobs import KINDS, STATUSES, AffineDesign, BatchCriticalThrust
 
-__all__ = ["BatchCriticalThrust", "critical_thrust_batch", "KINDS", "STATUSES"]
+__all__ = ["AffineDesign", "BatchCriticalThrust", "critical_thrust_batch", "KINDS", "STATUSES"]

@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 from ...model.model import Model
 from ..critical_thrust import _modes
 from ..linearize import ModelFamily
-from .jobs import KINDS, STATUSES, BatchCriticalThrust, _Job
+from .jobs import KINDS, STATUSES, AffineDesign, BatchCriticalThrust, _Job
 from .refine import _solve_jobs
 from .scan import _operators, _prime
 
@@ -27,15 +27,16 @@ def _single(model: Model) -> tuple:
 
 
 def critical_thrust_batch(
-    models: Sequence[Model | None], *, n_scan: int = 64, chunk: int = 32, vectorized: bool = True
+    models: Sequence[Model | AffineDesign | None], *, n_scan: int = 64, chunk: int = 32, vectorized: bool = True
 ) -> BatchCriticalThrust:
     """Critical thrust of every model, as :func:`impstab.critical_thrust` gives it for one.
 
     Parameters
     ----------
-    models : sequence of Model or None
+    models : sequence of Model, AffineDesign or None
         The designs; None marks a design to skip (status ``"invalid"``, empty message, for the
-        caller to fill in).
+        caller to fill in). An :class:`AffineDesign` (matrices of an undamped affine design,
+        assembled in bulk by a design study) is searched exactly as its model would be.
     n_scan, chunk : int
         Scan intervals, and scan points classified per batch (a design whose scan has gone
         unstable takes no further chunks).
@@ -60,6 +61,12 @@ def critical_thrust_batch(
     done: dict[int, tuple] = {}
     for i, model in enumerate(models):
         if model is None:
+            continue
+        if isinstance(model, AffineDesign):
+            out["t_max"][i], out["operating"][i] = model.thrust_max, model.operating
+            job = _Job.affine(model, n_scan)
+            jobs.append(job)
+            owner[id(job)] = (i, True)
             continue
         out["t_max"][i] = t_max = float(model.analysis.thrust_max)
         out["operating"][i] = np.nan if model.thrust.operating is None else float(model.thrust.operating)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,6 +18,31 @@ KINDS = ("none", "flutter", "divergence")
 #: status codes: index in this tuple (-1: not computed)
 STATUSES = ("ok", "invalid", "numerical_failure", "error")
 _EPS4 = 4 * np.finfo(float).eps
+
+
+@dataclass(frozen=True, eq=False)
+class AffineDesign:
+    """A design given by its matrices: undamped, non-gyroscopic, ``K = K0 + T K1`` exactly.
+
+    Attributes
+    ----------
+    mass, k0, k1 : (6, 6) arrays
+        ``M`` (kg, kg m, kg m^2), ``K0`` and ``K1`` (stiffness and its rate per newton of thrust).
+    thrust_max : float
+        End of the thrust search (N).
+    operating : float
+        Operating thrust (N; NaN without one).
+    family : callable
+        Returns the design's :class:`~impstab.linear.linearize.ModelFamily`, for the rare design
+        that needs its own engine (called at most once).
+    """
+
+    mass: Array
+    k0: Array
+    k1: Array
+    thrust_max: float
+    operating: float
+    family: Callable[[], ModelFamily]
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,7 +124,7 @@ class _Job:
     """One critical-load search: a design, or the undamped companion of a damped design."""
 
     def __init__(self, family: ModelFamily, p_max: float, n_scan: int) -> None:
-        self.family, self.p_max = family, p_max
+        self._family, self._factory, self.p_max = family, None, p_max
         self.grid = np.linspace(0.0, p_max, n_scan + 1)
         self.primed: dict = {}
         self.flags: list = []
@@ -110,6 +136,26 @@ class _Job:
         if self.fast:  # M^-1 K0 and M^-1 K1 are formed for all jobs at once (_operators)
             self.mass, self.k0, self.k1 = np.array(parts[0]), parts[3], parts[4]
         self.undamped = True if self.fast else self.engine().undamped
+
+    @classmethod
+    def affine(cls, design: AffineDesign, n_scan: int) -> "_Job":
+        """A job of an undamped affine design given by its matrices (no model assembled).
+
+        The model family is built from ``design.family`` only if the design needs its own engine.
+        """
+        job = cls.__new__(cls)
+        job._family, job._factory, job.p_max = None, design.family, design.thrust_max
+        job.grid = np.linspace(0.0, design.thrust_max, n_scan + 1)
+        job.primed, job.flags, job.ind, job.evaluations, job._engine = {}, [], [], 0, None
+        job.fast, job.undamped = True, True
+        job.mass, job.k0, job.k1 = design.mass, design.k0, design.k1
+        return job
+
+    @property
+    def family(self) -> ModelFamily:
+        if self._family is None:
+            self._family = self._factory()
+        return self._family
 
     def engine(self) -> _PrimedEngine:
         if self._engine is None:

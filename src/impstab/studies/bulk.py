@@ -1,0 +1,182 @@
+"""Bulk assembly of a chunk's variants when the study only moves and stiffens mounts.
+
+A study over mount stiffnesses and positions changes a few numbers of a model whose structure
+stays the same. For such a chunk the variants are not assembled one by one: the mount positions
+and stiffnesses of all designs are built at once from the assembled base model with the very
+functions the model assembly uses (:func:`~impstab.model.mounts.ring_positions`,
+:func:`~impstab.model.mounts.axial_shear_matrix`, which broadcast over designs), and the affine
+forms ``K = K0 + T K1`` of all designs come from one compiled loop
+(:func:`~impstab.linear.linearize.affine_forms`, the function every :class:`ModelFamily` uses).
+
+Every design is still validated like a model file: each value by its field's schema rule, and
+the model rule the changed values can break (the mounts must restrain all six rigid-body
+motions) on the assembled stiffness, with a margin. A design that fails or comes near either,
+or whose equilibrium would rotate under thrust (not affine), is handed back to the per-variant
+path, which gives it its exact status and message (:func:`impstab.model.model_from_dict`).
+
+Eligible: parameters among :data:`FIELDS` on a base model that is undamped, without propeller
+spin and without compressible fluid. Any other study takes the per-variant path.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..linear.batch import AffineDesign
+from ..linear.linearize import ModelFamily, affine_forms, pack_model
+from ..model.assemble import model_from_dict
+from ..model.mounts import axial_shear_matrix, condense, ring_positions
+from ..model.schema import ModelFile
+from .paths import _location, resolve_path, set_values
+
+__all__ = ["FIELDS", "BulkDesigns", "assemble_bulk"]
+
+Array = NDArray[np.float64]
+
+#: the fields assembled in bulk, per section (``mounts[i].position[j]`` included)
+FIELDS = {
+    "mount_rings": ("radius", "x", "start_angle", "k_axial", "k_shear"),
+    "mounts": ("position", "k_axial", "k_shear"),
+    "thrust": ("operating",),
+}
+#: a design whose stiffness has eigenvalues closer to singular than this (relative) goes to the
+#: per-variant path, which applies the model rule (1e-9) itself
+_RESTRAINT_MARGIN = 1e-8
+
+
+@dataclass(frozen=True, eq=False)
+class BulkDesigns:
+    """The designs of a chunk assembled in bulk.
+
+    Attributes
+    ----------
+    designs : list of AffineDesign or None
+        One entry per design of the chunk; None: the design takes the per-variant path.
+    """
+
+    designs: list[AffineDesign | None]
+
+
+def _eligible(segments: Sequence[tuple]) -> bool:
+    for seg in segments:
+        fields = FIELDS.get(seg[0])
+        if fields is None:
+            return False
+        if seg[0] == "thrust":
+            if tuple(seg[1:]) != ("operating",):
+                return False
+        elif len(seg) < 3 or not isinstance(seg[1], int) or seg[2] not in fields:
+            return False
+        elif seg[2] == "position" and len(seg) != 4 or seg[2] != "position" and len(seg) != 3:
+            return False
+    return True
+
+
+def _invalid(path, column: NDArray) -> NDArray[np.bool_]:
+    """Designs whose value breaks the field's schema rule (each distinct value checked once)."""
+    values, inverse = np.unique(column, return_inverse=True)
+    bad = np.zeros(len(values), dtype=bool)
+    for k, v in enumerate(values):
+        try:
+            path.check(v.item() if isinstance(v, np.generic) else v)
+        except ValueError:
+            bad[k] = True
+    return bad[inverse.ravel()]
+
+
+def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArray], name: str = "model") -> BulkDesigns | None:
+    """Matrices of every design of a chunk, or None when the study is not eligible.
+
+    Parameters
+    ----------
+    base : dict
+        The parsed base model file.
+    segments : sequence of tuple
+        Each parameter's path as keys and indices.
+    columns : sequence of arrays
+        Each parameter's value at each design.
+    name : str
+        Model name (for the per-design fallback models).
+    """
+    if not columns or not _eligible(segments):
+        return None
+    try:
+        doc = ModelFile.model_validate(base)
+        model = model_from_dict(base, name=name)
+    except Exception:  # noqa: BLE001 - the per-variant path reports it
+        return None
+    if model.is_damped or model.fluid.compressible or model.propeller.polar_inertia * model.propeller.speed != 0.0:
+        return None
+    for seg in segments:
+        if seg[0] == "mounts" and seg[2] in ("k_axial", "k_shear") and doc.mounts[seg[1]].stiffness is not None:
+            return None
+    n = len(columns[0])
+    paths = [resolve_path(_location(tuple(seg)), base) for seg in segments]
+    bad = np.zeros(n, dtype=bool)
+    for path, col in zip(paths, columns):
+        bad |= _invalid(path, col)
+    pk = pack_model(model)
+    positions = np.repeat(pk.positions[None], n, axis=0)
+    stiffness = np.repeat(pk.stiffness[None], n, axis=0)
+    values = {tuple(seg): np.asarray(col, dtype=float) for seg, col in zip(segments, columns)}
+    first = len(doc.mounts)
+    for i, ring in enumerate(doc.mount_rings):
+        sl = slice(first, first + ring.count)
+        first += ring.count
+        get = lambda key: values.get(("mount_rings", i, key), getattr(ring, key))  # noqa: E731,B023
+        if any(("mount_rings", i, key) in values for key in ("radius", "x", "start_angle")):
+            positions[:, sl] = ring_positions(ring.count, get("radius"), get("x"), get("start_angle"))
+        if any(("mount_rings", i, key) in values for key in ("k_axial", "k_shear")):
+            k3 = axial_shear_matrix(_unit(ring.axis), get("k_axial"), get("k_shear"))
+            stiffness[:, sl, :3, :3] = np.broadcast_to(k3, (n, 3, 3))[:, None]
+    for i, mount in enumerate(doc.mounts):
+        for j in range(3):
+            if ("mounts", i, "position", j) in values:
+                positions[:, i, j] = values[("mounts", i, "position", j)]
+        if any(("mounts", i, key) in values for key in ("k_axial", "k_shear")):
+            get = lambda key: values.get(("mounts", i, key), getattr(mount, key))  # noqa: E731,B023
+            stiffness[:, i, :3, :3] = axial_shear_matrix(_unit(mount.axis), get("k_axial"), get("k_shear"))
+    operating = values.get(("thrust", "operating"), np.full(n, np.nan if pk.operating is None else pk.operating))
+    t_max = doc.analysis.thrust_max
+    thrust_max = np.full(n, float(t_max)) if t_max is not None else 10.0 * operating
+    arms = np.concatenate([np.linalg.norm(positions, axis=-1), np.full((n, 1), np.linalg.norm(pk.r_thrust))], axis=1)
+    length_scale = np.maximum(arms.max(axis=1), 1e-3)
+    rep = lambda a: np.repeat(np.asarray(a, dtype=float)[None], n, axis=0)  # noqa: E731
+    # the model rule "the mounts restrain all six motions", on the condensed stiffness
+    with np.errstate(invalid="ignore", over="ignore"):
+        ev = np.linalg.eigvalsh(np.nan_to_num(condense(positions, stiffness)))
+    bad |= ~(ev[:, 0] > _RESTRAINT_MARGIN * ev[:, -1])
+    good = np.flatnonzero(~bad)
+    mass, _, k0, k1, _, affine = affine_forms(
+        rep(pk.mass6)[good], rep(pk.damp6)[good], positions[good], stiffness[good], np.zeros_like(stiffness[good]),
+        rep(pk.e_dir)[good], rep(pk.r_thrust)[good], np.full(len(good), pk.tangency), pk.preload,
+        length_scale[good], model.analysis.linearization == "equilibrium",
+    )
+    designs: list[AffineDesign | None] = [None] * n
+    for r in np.flatnonzero(affine):
+        j = int(good[r])
+        designs[j] = AffineDesign(
+            mass[r], k0[r], k1[r], float(thrust_max[j]), float(operating[j]),
+            _Factory(base, segments, [c[j] for c in columns], name),
+        )
+    return BulkDesigns(designs)
+
+
+class _Factory:
+    """The family of one design, assembled the per-variant way (only if its engine is needed)."""
+
+    def __init__(self, base: dict, segments, values, name: str) -> None:
+        self.base, self.segments, self.values, self.name = base, segments, values, name
+
+    def __call__(self) -> ModelFamily:
+        vals = [v.item() if isinstance(v, np.generic) else v for v in self.values]
+        return ModelFamily(model_from_dict(set_values(self.base, [tuple(s) for s in self.segments], vals), name=self.name))
+
+
+def _unit(vec) -> Array:
+    v = np.asarray(vec, dtype=float)
+    return v / float(np.linalg.norm(v))
