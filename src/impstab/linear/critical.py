@@ -32,6 +32,7 @@ from scipy import optimize
 
 from .eigen import kinetic_shares, state_matrices
 from .families import CallableFamily, LinearFamily, SystemFamily
+from .classify import classify_eigenvalues, unstable_masks
 from .small_eig import eigvals_small
 
 __all__ = ["CriticalLoad", "Crossing", "critical_load", "critical_load_family"]
@@ -190,39 +191,15 @@ class _Engine:
         """Masks of unstable eigenvalues: (flutter-type, divergence-type), per eigenvalue.
 
         Each eigenvalue is judged against its own magnitude (a stiff mode must not hide the
-        flutter of a soft one), with a rounding floor relative to the spectral radius.
+        flutter of a soft one), with a rounding floor relative to the spectral radius
+        (:mod:`impstab.linear.classify`).
         """
-        mag = np.abs(vals)
-        floor = FLOOR * mag.max(axis=-1, keepdims=True)
-        if self.undamped:
-            cplx = np.abs(vals.imag) > np.maximum(TOL_UNSTABLE * mag, floor)
-            neg = (vals.real < -floor) & ~cplx
-            return cplx, neg
-        grow = vals.real > np.maximum(TOL_UNSTABLE * mag, floor)
-        real = np.abs(vals.imag) <= np.maximum(TOL_CLUSTER * mag, floor)
-        return grow & ~real, grow & real
+        return unstable_masks(vals, self.undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR)
 
     def _classify_ops(self, ops: Array) -> tuple[Array, Array]:
-        vals = eigvals_small(ops)
-        cplx, neg = self.unstable_parts(vals)
-        unstable = (cplx | neg).any(axis=-1)
-        mag = np.maximum(np.abs(vals), 1e-300)
-        if self.undamped:
-            scale = mag.max(axis=-1)
-            re = vals.real / scale[:, None]
-            srt = np.sort(re, axis=-1)
-            diffs = np.diff(srt, axis=-1)
-            diffs[diffs < TOL_DUPLICATE] = np.inf
-            gap = diffs.min(axis=-1) if diffs.shape[-1] else np.full(len(ops), np.inf)
-            worst = -(np.abs(vals.imag) / mag).max(axis=-1)
-            # column 0: closest approach of two frequencies; column 1: smallest s (distance to
-            # divergence); both negative once unstable
-            indicator = np.stack(
-                [np.where(cplx.any(axis=-1), worst, gap), np.where(cplx.any(axis=-1), worst, srt[:, 0])], axis=-1
-            )
-            return unstable, indicator
-        growth = (vals.real / mag).max(axis=-1)
-        return unstable, np.stack([-growth, -growth], axis=-1)
+        # column 0: closest approach of two frequencies; column 1: smallest s (distance to
+        # divergence); both negative once unstable (damped: minus the largest growth rate)
+        return classify_eigenvalues(eigvals_small(ops), self.undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR, TOL_DUPLICATE)
 
     def unstable_at(self, p: float) -> bool:
         return bool(self.classify(np.array([p]))[0][0])

@@ -107,7 +107,7 @@ def condense(positions: Array, matrices: Array) -> Array:
     axes: designs of a study).
     """
     t = rigid_map6(np.asarray(positions, dtype=float))
-    return np.einsum("...mji,...mjk,...mkl->...il", t, np.asarray(matrices, dtype=float), t)
+    return (np.swapaxes(t, -1, -2) @ np.asarray(matrices, dtype=float) @ t).sum(axis=-3)
 
 
 def _condense(mounts, which: str) -> Array:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Callable
 
@@ -120,6 +121,14 @@ class _Stack(_Engine):
         return self._ops, None
 
 
+@functools.lru_cache(maxsize=64)
+def _grid(p_max: float, n_scan: int) -> Array:
+    """The scan grid ``linspace(0, p_max, n_scan + 1)``, shared (read-only) by designs alike."""
+    grid = np.linspace(0.0, p_max, n_scan + 1)
+    grid.setflags(write=False)
+    return grid
+
+
 class _Job:
     """One critical-load search: a design, or the undamped companion of a damped design."""
 
@@ -145,7 +154,7 @@ class _Job:
         """
         job = cls.__new__(cls)
         job._family, job._factory, job.p_max = None, design.family, design.thrust_max
-        job.grid = np.linspace(0.0, design.thrust_max, n_scan + 1)
+        job.grid = _grid(design.thrust_max, n_scan)
         job.primed, job.flags, job.ind, job.evaluations, job._engine = {}, [], [], 0, None
         job.fast, job.undamped = True, True
         job.mass, job.k0, job.k1 = design.mass, design.k0, design.k1

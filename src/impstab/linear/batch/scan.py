@@ -96,27 +96,43 @@ def _brackets(jobs: list[_Job], errors: dict) -> list:
         dips = inner[..., None] & (ind < prev_ind) & (ind <= nxt_ind)
     change = flags != prev
     cand = valid & (change | dips[..., 0] | dips[..., 1])
+    hit_change = cand & change
+    first_change = np.where(hit_change.any(axis=1), np.argmax(hit_change, axis=1), n_pts)
+    before = cand & ~change & (js < first_change[:, None])
+    # the dips a bubble search starts from: a dip of the smallest s (undamped), or a close
+    # approach of two frequencies that attract; the attraction test of every dip before the
+    # first change at once (each test depends on its own grid point only)
+    undamped = np.array([j.undamped for j in jobs])
+    smin_dips = before & dips[..., 1] & undamped[:, None]
+    attract = np.zeros_like(before)
+    where = list(zip(*(a.tolist() for a in np.nonzero(before & dips[..., 0]))))
+    if where:
+        attract[tuple(np.array(where).T)] = _attract_any(jobs, where, errors)
+    searched = smin_dips | attract
     out: list = [None] * len(jobs)
-    pos = {r: 0 for r in range(len(jobs))}
-    while pos:
+    pos: dict[int, int] = {}
+    for r in range(len(jobs)):
+        if id(jobs[r]) in errors:
+            continue
+        if searched[r].any():
+            pos[r] = 0
+        elif first_change[r] < n_pts:
+            out[r] = (jobs[r].grid[first_change[r] - 1], jobs[r].grid[first_change[r]])
+    while pos:  # rows with a bubble search to run: in order, all rows in lockstep
         dip: list[tuple[int, int]] = []
         for r in list(pos):
-            hits = np.flatnonzero(cand[r, pos[r]:])
+            hits = np.flatnonzero(searched[r, pos[r]:])
             if not hits.size:
                 del pos[r]
+                if first_change[r] < n_pts:
+                    out[r] = (jobs[r].grid[first_change[r] - 1], jobs[r].grid[first_change[r]])
                 continue
             j = pos[r] + int(hits[0])
             pos[r] = j + 1
-            if change[r, j]:
-                out[r] = (jobs[r].grid[j - 1], jobs[r].grid[j])
-                del pos[r]
-            else:
-                dip.append((r, j))
-        # a dip of the smallest s first, then a close approach of two frequencies that attract
-        first = _bubbles(jobs, [(r, j) for r, j in dip if dips[r, j, 1] and jobs[r].undamped], 1, errors)
-        rest = [(r, j) for r, j in dip if first.get(r) is None and dips[r, j, 0] and id(jobs[r]) not in errors]
-        attract = _attract_any(jobs, rest, errors)
-        second = _bubbles(jobs, [rj for rj in rest if attract.get(rj[0])], 0, errors)
+            dip.append((r, j))
+        first = _bubbles(jobs, [(r, j) for r, j in dip if smin_dips[r, j]], 1, errors)
+        rest = [(r, j) for r, j in dip if first.get(r) is None and attract[r, j] and id(jobs[r]) not in errors]
+        second = _bubbles(jobs, rest, 0, errors)
         for r, j in dip:
             if id(jobs[r]) in errors:
                 del pos[r]
@@ -125,21 +141,24 @@ def _brackets(jobs: list[_Job], errors: dict) -> list:
             if hit is not None:
                 out[r] = (jobs[r].grid[j - 1], hit)
                 del pos[r]
+    for r in range(len(jobs)):
+        if id(jobs[r]) in errors:
+            out[r] = None
     return out
 
 
-def _attract_any(jobs: list[_Job], where: list[tuple[int, int]], errors: dict) -> dict[int, bool]:
-    """The engine's ``attracting`` test for each (job, grid index)."""
-    out: dict[int, bool] = {}
-    fast = [(r, j) for r, j in where if jobs[r].fast]
+def _attract_any(jobs: list[_Job], where: list[tuple[int, int]], errors: dict) -> NDArray[np.bool_]:
+    """The engine's ``attracting`` test for each (job, grid index); False where it raised."""
+    out = np.zeros(len(where), dtype=bool)
+    fast = [k for k, (r, _) in enumerate(where) if jobs[r].fast]
     if fast:
-        out.update(zip([r for r, _ in fast], _attracting([jobs[r] for r, _ in fast], [j for _, j in fast])))
-    for r, j in where:
-        if jobs[r].fast:
+        out[fast] = _attracting([jobs[where[k][0]] for k in fast], [where[k][1] for k in fast])
+    for k, (r, j) in enumerate(where):
+        if jobs[r].fast or id(jobs[r]) in errors:
             continue
         g = jobs[r].grid
         try:
-            out[r] = jobs[r].engine().attracting(g[j - 1], g[j], g[j + 1])
+            out[k] = jobs[r].engine().attracting(g[j - 1], g[j], g[j + 1])
         except Exception as exc:  # noqa: BLE001 - reported per design
             errors[id(jobs[r])] = exc
     return out
