@@ -13,9 +13,10 @@ Measured in one run on this machine:
   solves: the sweep's count of eigenproblems times the per-problem time of ``eigvals`` on a large
   stack of the designs' own scan operators. ``lapack_fraction`` is that time over the sweep's.
 * **workers** -- the same study on a ``dask.distributed.LocalCluster`` of 1 and 2 worker
-  processes (one thread each), cluster started and warmed up before the clock starts. Beside
-  it, the machine's own parallelism: the same CPU-bound loop in 1 and then 2 processes at once
-  (on a machine whose two cores do not run two processes at full speed, no program scales).
+  processes (one thread each), cluster started and warmed up (one chunk on every worker)
+  before the clock starts. Beside it, the machine's own parallelism: the same CPU-bound loop
+  in 1 and then 2 processes at once (on a machine whose two cores do not run two processes at
+  full speed, no program scales).
 
 Ends with one JSON line:
 ``{"designs_per_s", "speedup_vs_loop", "lapack_fraction", "workers_scaling": {"1", "2"}, ...}``.
@@ -38,7 +39,9 @@ from impstab.linear.critical import _Engine
 from impstab.linear.linearize import ModelFamily
 from impstab.model import model_from_dict
 from impstab.studies import load_study, run_study
-from impstab.studies.evaluate import variant_dict
+from impstab.studies.evaluate import evaluate_chunk, variant_dict
+from impstab.studies.execute import chunk_task
+from impstab.studies.plan import plan_chunks
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "imp_symmetric.toml"
 
@@ -122,7 +125,9 @@ def worker_rate(study, tmp: Path, n_workers: int) -> float:
 
     with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=None,
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
-        client.run(lambda: impstab.critical_thrust(impstab.load_model(str(EXAMPLE))))  # import, JIT cache
+        # warm-up like the in-process run's: one chunk of the study on every worker (imports,
+        # compiled-code caches), before the clock starts
+        client.run(evaluate_chunk, chunk_task(study, plan_chunks(study), 0))
         seconds, _ = timed_study(study, tmp / f"w{n_workers}.zarr", client=client)
     return study.size / seconds
 

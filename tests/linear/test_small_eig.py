@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from impstab.linear.small_eig import MAX_ORDER, eigvals_small
+from impstab.linear.small_eig import MAX_ORDER, eigvals_affine, eigvals_small
 
 EPS = np.finfo(float).eps
 
@@ -115,3 +115,16 @@ def test_non_finite_and_large_orders_go_to_lapack():
     assert _match(eigvals_small(big)[0], np.linalg.eigvals(big)[0]) < 1e-10
     with pytest.raises(ValueError, match="square"):
         eigvals_small(np.ones((2, 3)))
+
+
+def test_affine_family_equals_the_formed_stack():
+    rng = np.random.default_rng(8)
+    a0, a1 = rng.standard_normal((2, 30, 6, 6))
+    loads = rng.uniform(0, 5, (30, 9))
+    got = eigvals_affine(a0, a1, loads)
+    formed = a0[:, None] + loads[..., None, None] * a1[:, None]
+    np.testing.assert_array_equal(got, eigvals_small(formed))
+    assert _match(got[3, 4], np.linalg.eigvals(formed[3, 4])) < 1e-12 * np.abs(formed[3, 4]).max()
+    loads[2, 1] = np.nan  # a non-finite matrix goes to LAPACK, which refuses it
+    with pytest.raises(np.linalg.LinAlgError):
+        eigvals_affine(a0, a1, loads)

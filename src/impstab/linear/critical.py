@@ -197,9 +197,15 @@ class _Engine:
         return unstable_masks(vals, self.undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR)
 
     def _classify_ops(self, ops: Array) -> tuple[Array, Array]:
-        # column 0: closest approach of two frequencies; column 1: smallest s (distance to
-        # divergence); both negative once unstable (damped: minus the largest growth rate)
-        return classify_eigenvalues(eigvals_small(ops), self.undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR, TOL_DUPLICATE)
+        return self.classify_eigenvalues(eigvals_small(ops))
+
+    def classify_eigenvalues(self, vals: Array) -> tuple[Array, Array]:
+        """Stability flags and indicators of problems with eigenvalues ``vals (N, n)``.
+
+        Indicator column 0: closest approach of two frequencies; column 1: smallest s (distance
+        to divergence); both negative once unstable (damped: minus the largest growth rate).
+        """
+        return classify_eigenvalues(vals, self.undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR, TOL_DUPLICATE)
 
     def unstable_at(self, p: float) -> bool:
         return bool(self.classify(np.array([p]))[0][0])

@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-__all__ = ["eigvals_small", "MAX_ORDER"]
+__all__ = ["eigvals_small", "eigvals_affine", "MAX_ORDER"]
 
 #: largest order solved here; larger matrices go to LAPACK
 MAX_ORDER = 24
@@ -242,6 +242,17 @@ def _francis(a, n, wr, wi):  # noqa: C901 - one algorithm, kept in one piece
 
 
 @njit(cache=True)
+def _solve_one(a, n, v, wr, wi, out_row):
+    """Eigenvalues of the finite matrix in ``a`` (destroyed) into ``out_row``; False: no convergence."""
+    _balance(a, n)
+    _hessenberg(a, n, v)
+    ok = _francis(a, n, wr, wi)
+    for i in range(n):
+        out_row[i] = complex(wr[i], wi[i])
+    return ok
+
+
+@njit(cache=True)
 def _eigvals_stack(ops, out, ok):
     count, n = ops.shape[0], ops.shape[1]
     a = np.empty((n, n))
@@ -258,11 +269,50 @@ def _eigvals_stack(ops, out, ok):
         if not finite:
             ok[s] = False
             continue
-        _balance(a, n)
-        _hessenberg(a, n, v)
-        ok[s] = _francis(a, n, wr, wi)
-        for i in range(n):
-            out[s, i] = complex(wr[i], wi[i])
+        ok[s] = _solve_one(a, n, v, wr, wi, out[s])
+
+
+@njit(cache=True)
+def _eigvals_affine(a0, a1, loads, out, ok):
+    count, n = a0.shape[0], a0.shape[1]
+    a = np.empty((n, n))
+    v = np.empty(n)
+    wr = np.empty(n)
+    wi = np.empty(n)
+    for s in range(count):
+        for k in range(loads.shape[1]):
+            p = loads[s, k]
+            finite = True
+            for i in range(n):
+                for j in range(n):
+                    a[i, j] = a0[s, i, j] + p * a1[s, i, j]
+                    if not np.isfinite(a[i, j]):
+                        finite = False
+            if not finite:
+                ok[s, k] = False
+                continue
+            ok[s, k] = _solve_one(a, n, v, wr, wi, out[s, k])
+
+
+def eigvals_affine(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """Eigenvalues of ``a0[i] + loads[i, k] a1[i]`` for every ``i`` and ``k``, shape ``(N, K, n)``.
+
+    The same as :func:`eigvals_small` on the formed stack (the matrices are formed with the same
+    arithmetic, one at a time, so that the stack is never held in memory).
+    """
+    a0 = np.ascontiguousarray(a0, dtype=float)
+    a1 = np.ascontiguousarray(a1, dtype=float)
+    loads = np.ascontiguousarray(loads, dtype=float)
+    n = a0.shape[-1]
+    if n > MAX_ORDER or n == 0:
+        return np.linalg.eigvals(a0[:, None] + loads[..., None, None] * a1[:, None])
+    out = np.empty(loads.shape + (n,), dtype=np.complex128)
+    ok = np.ones(loads.shape, dtype=np.bool_)
+    _eigvals_affine(a0, a1, loads, out, ok)
+    if not ok.all():
+        s, k = np.nonzero(~ok)
+        out[s, k] = np.linalg.eigvals(a0[s] + loads[s, k][:, None, None] * a1[s])
+    return out
 
 
 def eigvals_small(ops: NDArray[np.float64]) -> NDArray[np.complex128]:

@@ -74,6 +74,7 @@ class StudyStore:
         self.group = group
         self.plan = plan
         self.path = path
+        self._arrays: dict = {}  # the result arrays, opened once
 
     # -- creation and resumption -------------------------------------------------------------
     @classmethod
@@ -119,7 +120,9 @@ class StudyStore:
         """Write one chunk's data, then its completion record."""
         sl = self.plan.slices(result.index)
         for name, arr in result.data.items():
-            self.group[name][sl] = arr
+            if name not in self._arrays:
+                self._arrays[name] = self.group[name]
+            self._arrays[name][sl] = arr
         rec = self.group["progress/chunks"]
         runs = rec[result.index, 1]
         runs = 0.0 if not np.isfinite(runs) else float(runs)

@@ -6,6 +6,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..critical import TOL_DUPLICATE, TOL_UNSTABLE
+from ..small_eig import eigvals_affine
 from .jobs import _Job, _Stack
 
 Array = NDArray[np.float64]
@@ -24,16 +25,17 @@ def _operators(jobs: list[_Job]) -> None:
 
 
 def _classify_group(jobs: list[_Job], start: int, stop: int) -> list:
-    if jobs[0].fast:
-        a0 = np.stack([j.a0 for j in jobs])
-        a1 = np.stack([j.a1 for j in jobs])
-        p = np.stack([j.grid[start:stop] for j in jobs])
-        ops = a0[:, None] + p[:, :, None, None] * a1[:, None]
-    else:
-        ops = np.stack([j.engine().operators(j.grid[start:stop])[0] for j in jobs])
-    flat = ops.reshape((-1,) + ops.shape[2:])
     try:
-        flags, ind = _Stack(flat, jobs[0].undamped).classify(np.zeros(len(flat)))
+        if jobs[0].fast:  # the operators a0 + p a1 are formed one at a time in the kernel
+            a0 = np.stack([j.a0 for j in jobs])
+            a1 = np.stack([j.a1 for j in jobs])
+            p = np.stack([j.grid[start:stop] for j in jobs])
+            vals = eigvals_affine(a0, a1, p)
+            flags, ind = _Stack(None, True).classify_eigenvalues(vals.reshape(-1, vals.shape[-1]))
+        else:
+            ops = np.stack([j.engine().operators(j.grid[start:stop])[0] for j in jobs])
+            flat = ops.reshape((-1,) + ops.shape[2:])
+            flags, ind = _Stack(flat, jobs[0].undamped).classify(np.zeros(len(flat)))
     except np.linalg.LinAlgError:
         out = []
         for j in jobs:
