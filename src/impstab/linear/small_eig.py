@@ -243,7 +243,14 @@ def _francis(a, n, wr, wi):  # noqa: C901 - one algorithm, kept in one piece
 
 @njit(cache=True)
 def _solve_one(a, n, v, wr, wi, out_row):
-    """Eigenvalues of the finite matrix in ``a`` (destroyed) into ``out_row``; False: no convergence."""
+    """Eigenvalues of the matrix in ``a`` (destroyed) into ``out_row``.
+
+    False when it is not finite or the iteration does not converge (the caller asks LAPACK).
+    """
+    for i in range(n):
+        for j in range(n):
+            if not np.isfinite(a[i, j]):
+                return False
     _balance(a, n)
     _hessenberg(a, n, v)
     ok = _francis(a, n, wr, wi)
@@ -254,43 +261,23 @@ def _solve_one(a, n, v, wr, wi, out_row):
 
 @njit(cache=True)
 def _eigvals_stack(ops, out, ok):
-    count, n = ops.shape[0], ops.shape[1]
-    a = np.empty((n, n))
-    v = np.empty(n)
-    wr = np.empty(n)
-    wi = np.empty(n)
-    for s in range(count):
-        finite = True
-        for i in range(n):
-            for j in range(n):
-                a[i, j] = ops[s, i, j]
-                if not np.isfinite(a[i, j]):
-                    finite = False
-        if not finite:
-            ok[s] = False
-            continue
+    n = ops.shape[1]
+    a, v, wr, wi = np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n)
+    for s in range(ops.shape[0]):
+        a[:, :] = ops[s]
         ok[s] = _solve_one(a, n, v, wr, wi, out[s])
 
 
 @njit(cache=True)
 def _eigvals_affine(a0, a1, loads, out, ok):
-    count, n = a0.shape[0], a0.shape[1]
-    a = np.empty((n, n))
-    v = np.empty(n)
-    wr = np.empty(n)
-    wi = np.empty(n)
-    for s in range(count):
+    n = a0.shape[1]
+    a, v, wr, wi = np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n)
+    for s in range(a0.shape[0]):
         for k in range(loads.shape[1]):
             p = loads[s, k]
-            finite = True
             for i in range(n):
                 for j in range(n):
                     a[i, j] = a0[s, i, j] + p * a1[s, i, j]
-                    if not np.isfinite(a[i, j]):
-                        finite = False
-            if not finite:
-                ok[s, k] = False
-                continue
             ok[s, k] = _solve_one(a, n, v, wr, wi, out[s, k])
 
 
