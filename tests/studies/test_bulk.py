@@ -20,7 +20,8 @@ def _mixed_base(linearization="classical"):
     d = asymmetric_model_dict(analysis={"thrust_max": 60000.0, "linearization": linearization})
     d["mounts"] = [dict(m) for m in d["mounts"][1:3]]
     d["mount_rings"] = [{"count": 4, "radius": 0.2, "x": -0.1, "start_angle": 10.0, "axis": [1.0, 0.0, 0.1],
-                         "k_axial": 8e4, "k_shear": 1.5e4}]
+                         "k_axial": 8e4, "k_shear": 1.5e4},
+                        {"count": 3, "radius": 0.12, "x": 0.35, "k_axial": 5e4, "k_shear": 1e4}]
     return d
 
 
@@ -30,6 +31,8 @@ PATHS = [
     (("mount_rings", 0, "start_angle"), -90.0, 90.0),
     (("mount_rings", 0, "k_axial"), 3e4, 2e5),
     (("mount_rings", 0, "k_shear"), 5e3, 4e4),
+    (("mount_rings", 1, "x"), 0.25, 0.45),
+    (("mount_rings", 1, "k_shear"), 5e3, 2e4),
     (("mounts", 0, "position", 0), 0.1, 0.4),
     (("mounts", 1, "position", 2), -0.2, 0.0),
     (("mounts", 0, "k_axial"), 5e4, 2e5),
@@ -42,8 +45,17 @@ def _columns(rng, n, paths=PATHS):
     return [p[0] for p in paths], [rng.uniform(p[1], p[2], n) for p in paths]
 
 
-def test_matrices_equal_the_per_variant_assembly():
-    base = _mixed_base()
+def _fluid_base():
+    """Incompressible added mass of a baffled cylinder, no thrust_max (10x the operating thrust)."""
+    d = _mixed_base()
+    d["hull"] = {"radius": 0.25, "length": 2.0, "center": [-0.3, 0.0, 0.0]}
+    d["fluid"] = {"model": "baffled-cylinder", "density": 1025.0}
+    d["analysis"] = {"linearization": "classical"}
+    return d
+
+
+@pytest.mark.parametrize("base", [_mixed_base(), _fluid_base()], ids=["mounts", "fluid"])
+def test_matrices_equal_the_per_variant_assembly(base):
     segs, cols = _columns(np.random.default_rng(1), 25)
     bulk = assemble_bulk(base, segs, cols)
     assert bulk is not None and all(isinstance(d, AffineDesign) for d in bulk.designs)
