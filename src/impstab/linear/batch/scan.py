@@ -294,9 +294,19 @@ def _attracting(jobs: list[_Job], js: list[int]) -> NDArray[np.bool_]:
     np.put_along_axis(upper, order, upper_s, -1)
     rate = (op(hi) - op(lo)) / (hi - lo)[:, None, None]
     b = np.linalg.solve(vecs, rate.astype(complex) @ vecs)
-    blu = b * (lower[:, :, None] & upper[:, None, :])
-    bul = b * (upper[:, :, None] & lower[:, None, :])
-    inter = np.linalg.eigvals(blu @ bul)
     norm = np.maximum(np.abs(rate).max(axis=(-2, -1)), 1e-300)
-    pulled = np.any(inter.real < -1e-8 * norm[:, None] ** 2, axis=-1)
+    # the interaction B_lu B_ul of the two clusters, a k_l x k_l block (the engine's product),
+    # for all rows with the same cluster sizes at once
+    pulled = np.zeros(len(b), dtype=bool)
+    n_lower, n_upper = lower.sum(-1), upper.sum(-1)
+    for kl, ku in set(zip(n_lower.tolist(), n_upper.tolist())):
+        rows = np.flatnonzero((n_lower == kl) & (n_upper == ku))
+        li = np.nonzero(lower[rows])[1].reshape(len(rows), kl)
+        ui = np.nonzero(upper[rows])[1].reshape(len(rows), ku)
+        br = b[rows]
+        b_lu = np.take_along_axis(np.take_along_axis(br, li[:, :, None], 1), ui[:, None, :], 2)
+        b_ul = np.take_along_axis(np.take_along_axis(br, ui[:, :, None], 1), li[:, None, :], 2)
+        prod = b_lu @ b_ul
+        inter = prod[:, 0, :] if kl == 1 else np.linalg.eigvals(prod)
+        pulled[rows] = np.any(inter.real < -1e-8 * norm[rows, None] ** 2, axis=-1)
     return np.where(result, True, distinct.any(-1) & pulled)
