@@ -8,7 +8,7 @@ from conftest import asymmetric_model_dict, ring_model_dict
 
 import impstab
 from impstab.errors import ModelError
-from impstab.linear.batch import STATUSES, AffineDesign
+from impstab.linear.batch import KINDS, STATUSES, AffineDesign, critical_thrust_batch
 from impstab.linear.linearize import ModelFamily
 from impstab.model import model_from_dict
 from impstab.studies.bulk import assemble_bulk
@@ -143,3 +143,18 @@ def test_a_full_stiffness_mount_is_not_assembled_in_bulk():
     bad["mounts"][3]["k_axial"] = 1.0  # not read: the mount has a 6x6 stiffness
     assert assemble_bulk(base, [("mounts", 3, "k_axial")], [np.array([1.0, 2.0])]) is None
     assert assemble_bulk(base, [("mounts", 0, "k_axial")], [np.array([1e5, 2e5])]) is not None
+
+
+def test_a_bulk_design_that_needs_its_own_engine_builds_its_model():
+    # vectorized=False sends every design to its own engine: the family comes from the factory
+    base = _mixed_base()
+    segs, cols = _columns(np.random.default_rng(4), 3)
+    designs = assemble_bulk(base, segs, cols).designs
+    got = critical_thrust_batch(designs, vectorized=False)
+    for j in range(3):
+        ref = impstab.critical_thrust(model_from_dict(variant_dict(base, segs, [c[j] for c in cols])))
+        assert got.status[j] == 0 and KINDS[got.kind[j]] == ref.kind
+        if ref.thrust is None:
+            assert np.isnan(got.thrust[j])
+        else:
+            assert abs(got.thrust[j] - ref.thrust) <= 1e-10 * ref.thrust

@@ -134,7 +134,7 @@ class _Job:
 
     def __init__(self, family: ModelFamily, p_max: float, n_scan: int) -> None:
         self._family, self._factory, self.p_max = family, None, p_max
-        self.grid = np.linspace(0.0, p_max, n_scan + 1)
+        self.grid = _grid(p_max, n_scan)
         self.primed: dict = {}
         self.flags: list = []
         self.ind: list = []
