@@ -193,3 +193,33 @@ def test_numerical_failure_of_one_design(monkeypatch):
     assert got.status.tolist() == [0, STATUSES.index("numerical_failure"), 0]
     assert "no static equilibrium" in got.message[1]
     assert np.isnan(got.thrust[1]) and got.thrust[0] == got.thrust[2]
+
+
+def _planar_closed_form(x, k_sh, k_ax=1.0e5, radius=0.15, m=100.0, inertia=6.0):
+    """Flutter thrust of the symmetric three-mount ring (sway-yaw plane, preload), THEORY 4."""
+    k_y, k_yt = 3 * k_sh, 3 * k_sh * x
+    c0 = 3 * k_sh * x**2 + 1.5 * k_ax * radius**2
+    p = k_y * inertia + m * c0
+    return (p - 2 * np.sqrt(m * inertia * (k_y * c0 - k_yt**2))) / (m * x)
+
+
+def test_grid_sweep_equals_the_closed_form(tmp_path):
+    """An independent answer for every design of a grid: the planar closed form of the ring."""
+    study = load_study(write_study(tmp_path, """
+[[parameters]]
+path = "mount_rings[0].x"
+values = { start = 0.1, stop = 0.4, num = 7 }
+[[parameters]]
+path = "mount_rings[0].k_shear"
+values = { start = 5e3, stop = 5e4, num = 9, scale = "log" }
+""", chunk_size=20))
+    ds = run_study(study, None).dataset
+    x = ds["mount_rings[0].x"].values[:, None]
+    k_sh = ds["mount_rings[0].k_shear"].values[None, :]
+    exact = _planar_closed_form(x, k_sh)
+    got, kind = ds["critical_thrust"].values, ds["kind"].values
+    flutter = exact <= 20000.0
+    assert flutter.sum() >= 20 and (~flutter).sum() >= 10
+    assert (kind[flutter] == 1).all() and (kind[~flutter] == 0).all()
+    np.testing.assert_allclose(got[flutter], exact[flutter], rtol=1e-11)
+    np.testing.assert_allclose(ds["margin"].values[flutter], exact[flutter] / 2000.0, rtol=1e-11)
