@@ -71,7 +71,7 @@ def _eligible(segments: Sequence[tuple]) -> bool:
                 return False
         elif len(seg) < 3 or not isinstance(seg[1], int) or seg[2] not in fields:
             return False
-        elif seg[2] == "position" and len(seg) != 4 or seg[2] != "position" and len(seg) != 3:
+        elif len(seg) != (4 if seg[2] == "position" else 3):
             return False
     return True
 
