@@ -9,7 +9,8 @@ Timed (median of repeats, ``time.perf_counter``, the result cache cleared before
 Baseline: the plain method, adaptive QUADPACK (``scipy.integrate.quad``, epsrel 1e-13) on the real
 axis cut into half-periods of the window, with the tail beyond a few radii by QUADPACK's
 Fourier-integral routine (QAWF); four integrals per point (translation and rotation, real and
-imaginary parts). It also serves as the first refined computation; the second is impstab's own
+imaginary parts): ``tests/fluid/fluid_reference.py``, the test suite's independent route. It
+also serves as the first refined computation; the second is impstab's own
 panel layout with four times as many panels and a much deeper grading.
 
 ``rel_err_vs_refined`` is the largest relative difference of the four coefficients (added mass,
@@ -24,52 +25,19 @@ import math
 import statistics
 import sys
 import time
-import warnings
+from pathlib import Path
 
 import numpy as np
-from scipy import integrate, special
 
 import impstab.fluid as fl
 from impstab.fluid.baffled_cylinder import _baffled_cylinder
 from impstab.fluid.integrals import window_integrals
 
+# the plain method is the test suite's independent reference, one implementation for both
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "fluid"))
+from fluid_reference import window_integral  # noqa: E402
+
 A, L, RHO, C, F = 0.15, 0.8, 1025.0, 1500.0, 500.0
-
-
-def _ratio(s: float, s0: float) -> complex:
-    if s > s0:
-        w = math.sqrt(s * s - s0 * s0)
-        return special.kve(1, w) / (w * special.kve(0, w) + special.kve(1, w))
-    x = math.sqrt(s0 * s0 - s * s)
-    return -special.hankel2(1, x) / (x * special.h2vp(1, x))
-
-
-def _quad(f, a, b, **kw) -> float:
-    tol = {"epsabs": 1e-17} if "weight" in kw else {"epsabs": 0.0, "epsrel": 1e-13}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", integrate.IntegrationWarning)
-        return integrate.quad(f, a, b, limit=400, **tol, **kw)[0]
-
-
-def quad_integral(ell: float, s0: float, order: int) -> complex:
-    """``integral_0^inf r(s) j_order(ell s)^2 ds`` by adaptive quadrature (the plain method)."""
-    cut = s0 + max(8.0, 8.0 / ell)
-    period = math.pi / (2.0 * ell)
-    edges = sorted({0.0, s0, cut, *np.arange(period, cut, period).tolist()})
-    window = lambda s: special.spherical_jn(order, ell * s) ** 2  # noqa: E731
-    total = 0.0 + 0.0j
-    for a, b in zip(edges[:-1], edges[1:]):
-        total += _quad(lambda s: _ratio(s, s0).real * window(s), a, b)
-        if b <= s0:
-            total += 1j * _quad(lambda s: _ratio(s, s0).imag * window(s), a, b)
-    if order == 0:
-        n, p, q = (lambda x: 0.5 / x**2), (lambda x: -0.5 / x**2), (lambda x: 0.0 * x)
-    else:
-        n, p, q = (lambda x: (1 + x**2) / (2 * x**4)), (lambda x: (x**2 - 1) / (2 * x**4)), (lambda x: -1.0 / x**3)
-    total += _quad(lambda s: _ratio(s, s0).real * n(ell * s), cut, np.inf)
-    total += _quad(lambda s: _ratio(s, s0).real * p(ell * s), cut, np.inf, weight="cos", wvar=2 * ell)
-    total += _quad(lambda s: _ratio(s, s0).real * q(ell * s), cut, np.inf, weight="sin", wvar=2 * ell)
-    return total
 
 
 def coefficients(j0: complex, j1: complex, omega: float) -> np.ndarray:
@@ -98,7 +66,7 @@ def main() -> int:
         got = np.array([r.added_mass, r.added_inertia, r.radiation_resistance or 0.0,
                         r.rotational_radiation_resistance or 0.0])
         t0 = time.perf_counter()
-        plain = coefficients(quad_integral(ell, s0, 0), quad_integral(ell, s0, 1), omega)
+        plain = coefficients(window_integral(ell, s0, 0), window_integral(ell, s0, 1), omega)
         plain_ms = 1e3 * (time.perf_counter() - t0)
         fine = window_integrals(ell, s0, refine=4)
         refined = coefficients(*fine.values, omega)
