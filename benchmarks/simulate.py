@@ -38,6 +38,10 @@ import impstab
 from impstab.dynamics.simulate import default_step
 from impstab.linear.kinematics import euler_zyx_to_matrix
 
+# the Exudyn model is the peer test's own, one implementation for both
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "dynamics"))
+from exudyn_peer import exudyn_system  # noqa: E402
+
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "imp_symmetric.toml"
 THRUST = 5000.0
 STEPS = 100_000
@@ -95,35 +99,16 @@ def exudyn_seconds(model, res, duration):
     """Wall time of Exudyn's RK44 over the same steps, and its final weighted state; None without it."""
     try:
         import exudyn as exu
-        from exudyn.utilities import RigidBodyInertia
     except ImportError:
         return None, None
     warnings.simplefilter("ignore", DeprecationWarning)
+    y0 = res.equilibrium + res.deviation[0]
     times, final = [], None
     for _ in range(REPEATS):
-        sc = exu.SystemContainer()
-        mbs = sc.AddSystem()
-        ground = mbs.CreateGround()
-        y0 = res.equilibrium + res.deviation[0]
-        body = mbs.CreateRigidBody(inertia=RigidBodyInertia(mass=model.body.mass, inertiaTensor=np.array(model.body.inertia_cg)),
-                                   referencePosition=list(y0[:3]), initialVelocity=list(y0[6:9]),
-                                   initialAngularVelocity=list(y0[9:]), nodeType=exu.NodeType.RotationRxyz)
-        for mt in model.mounts:
-            mbs.CreateCartesianSpringDamper(itemNumbers=[ground, body], localPosition0=list(mt.position),
-                                            localPosition1=list(mt.position), stiffness=list(np.diag(mt.stiffness)[:3]),
-                                            damping=[0.0, 0.0, 0.0])
-        mbs.CreateForce(itemNumber=body, localPosition=list(model.thrust.point),
-                        loadVector=list(THRUST * model.thrust.direction), bodyFixed=True)
-        mbs.Assemble()
-        s = exu.SimulationSettings()
-        s.timeIntegration.numberOfSteps = STEPS
-        s.timeIntegration.endTime = duration
-        s.timeIntegration.verboseMode = 0
-        s.solutionSettings.writeSolutionToFile = False
+        _, mbs, settings, node = exudyn_system(model, THRUST, y0[:6], y0[6:], duration, STEPS)
         t0 = time.perf_counter()
-        mbs.SolveDynamic(s, solverType=exu.DynamicSolverType.RK44)
+        mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.RK44)
         times.append(time.perf_counter() - t0)
-        node = mbs.GetObject(body)["nodeNumber"]
         final = np.array(mbs.GetNodeOutput(node, exu.OutputVariableType.Position)) - res.equilibrium[:3]
     return statistics.median(times), final
 

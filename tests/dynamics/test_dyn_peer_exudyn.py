@@ -5,6 +5,7 @@ trajectory. Skipped when ``exudyn`` is not installed."""
 import numpy as np
 import pytest
 from _dyn_models import symmetric
+from exudyn_peer import exudyn_system
 
 import impstab
 from impstab.linear.kinematics import euler_zyx_to_matrix
@@ -14,32 +15,8 @@ exu = pytest.importorskip("exudyn")
 
 
 def exudyn_run(model, thrust, eta0, nu0, t_end, steps):
-    from exudyn.utilities import RigidBodyInertia
-
-    sc = exu.SystemContainer()
-    mbs = sc.AddSystem()
-    ground = mbs.CreateGround()
-    rot0 = euler_zyx_to_matrix(*eta0[3:])
-    body = mbs.CreateRigidBody(
-        inertia=RigidBodyInertia(mass=model.body.mass, inertiaTensor=np.array(model.body.inertia_cg)),
-        referencePosition=list(eta0[:3]), referenceRotationMatrix=rot0, initialVelocity=list(rot0 @ nu0[:3]),
-        initialAngularVelocity=list(rot0 @ nu0[3:]), nodeType=exu.NodeType.RotationRxyz)
-    for mt in model.mounts:
-        k = mt.stiffness
-        assert np.count_nonzero(k - np.diag(np.diag(k))) == 0  # axis-aligned springs only
-        mbs.CreateCartesianSpringDamper(itemNumbers=[ground, body], localPosition0=list(mt.position),
-                                        localPosition1=list(mt.position), stiffness=list(np.diag(k)[:3]),
-                                        damping=[0.0, 0.0, 0.0])
-    mbs.CreateForce(itemNumber=body, localPosition=list(model.thrust.point),
-                    loadVector=list(thrust * model.thrust.direction), bodyFixed=True)
-    mbs.Assemble()
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.numberOfSteps = steps
-    settings.timeIntegration.endTime = t_end
-    settings.timeIntegration.verboseMode = 0
-    settings.solutionSettings.writeSolutionToFile = False
+    _, mbs, settings, node = exudyn_system(model, thrust, eta0, nu0, t_end, steps)
     mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.RK44)
-    node = mbs.GetObject(body)["nodeNumber"]
     pos = np.array(mbs.GetNodeOutput(node, exu.OutputVariableType.Position))
     rot = np.array(mbs.GetNodeOutput(node, exu.OutputVariableType.RotationMatrix)).reshape(3, 3)
     return pos, rot
