@@ -21,7 +21,7 @@ from .mounts import Mount, axial_shear_matrix, elastic_stiffness, ring_positions
 from .schema import ModelFile
 from .thrust import Propeller, Thrust
 
-__all__ = ["load_model", "model_from_dict", "format_location"]
+__all__ = ["load_model", "model_from_dict", "format_location", "unit_vector"]
 
 _SYM_TOL = 1e-9
 
@@ -66,7 +66,8 @@ def _from_validation_error(err: ValidationError, data: Any) -> ModelError:
     return ModelError(field, value, msg[0].lower() + msg[1:])
 
 
-def _unit(vec: list[float], field: str) -> np.ndarray:
+def unit_vector(vec: list[float], field: str) -> np.ndarray:
+    """``vec / |vec|``; a zero vector is a ModelError naming ``field``."""
     v = np.asarray(vec, dtype=float)
     n = float(np.linalg.norm(v))
     if n == 0.0:
@@ -113,7 +114,7 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             for key in ("k_axial", "k_shear"):
                 if getattr(m, key) is None:
                     raise ModelError(f"{f}.{key}", None, "is required (or give a full 6x6 'stiffness')")
-            axis = _unit(m.axis, f"{f}.axis")
+            axis = unit_vector(m.axis, f"{f}.axis")
             k6 = np.zeros((6, 6))
             k6[:3, :3] = axial_shear_matrix(axis, m.k_axial, m.k_shear)
         if m.damping is not None:
@@ -122,13 +123,13 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             c6 = np.asarray(m.damping, float)
             _symmetric_psd(c6, f"{f}.damping")
         else:
-            axis = _unit(m.axis, f"{f}.axis")
+            axis = unit_vector(m.axis, f"{f}.axis")
             c6 = np.zeros((6, 6))
             c6[:3, :3] = axial_shear_matrix(axis, m.c_axial, m.c_shear)
         mounts.append(Mount(pos, k6, c6))
     for i, ring in enumerate(doc.mount_rings):
         f = f"mount_rings[{i}]"
-        axis = _unit(ring.axis, f"{f}.axis")
+        axis = unit_vector(ring.axis, f"{f}.axis")
         for pos in ring_positions(ring.count, ring.radius, ring.x, ring.start_angle):
             mounts.append(Mount.axial_shear(pos, axis, ring.k_axial, ring.k_shear, ring.c_axial, ring.c_shear))
     if not mounts:
@@ -177,7 +178,7 @@ def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
     mounts = _mounts(doc)
     t = doc.thrust
     thrust = Thrust(
-        np.asarray(t.point, float), _unit(t.direction, "thrust.direction"), t.tangency, t.operating,
+        np.asarray(t.point, float), unit_vector(t.direction, "thrust.direction"), t.tangency, t.operating,
         t.preload_stiffness,
     )
     prop = doc.propeller or Propeller()

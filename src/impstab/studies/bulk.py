@@ -20,6 +20,7 @@ spin and without compressible fluid. Any other study takes the per-variant path.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -28,10 +29,10 @@ from numpy.typing import NDArray
 
 from ..linear.batch import AffineDesign
 from ..linear.linearize import ModelFamily, affine_forms, pack_model
-from ..model.assemble import model_from_dict
+from ..model.assemble import model_from_dict, unit_vector
 from ..model.mounts import axial_shear_matrix, condense, ring_positions
 from ..model.schema import ModelFile
-from .paths import _location, resolve_path, set_values
+from .paths import _location, resolve_path, variant_dict
 
 __all__ = ["FIELDS", "BulkDesigns", "assemble_bulk"]
 
@@ -131,7 +132,7 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
         if any(("mount_rings", i, key) in values for key in ("radius", "x", "start_angle")):
             positions[:, sl] = ring_positions(ring.count, get("radius"), get("x"), get("start_angle"))
         if any(("mount_rings", i, key) in values for key in ("k_axial", "k_shear")):
-            k3 = axial_shear_matrix(_unit(ring.axis), get("k_axial"), get("k_shear"))
+            k3 = axial_shear_matrix(unit_vector(ring.axis, f"mount_rings[{i}].axis"), get("k_axial"), get("k_shear"))
             stiffness[:, sl, :3, :3] = np.broadcast_to(k3, (n, 3, 3))[:, None]
     for i, mount in enumerate(doc.mounts):
         for j in range(3):
@@ -139,44 +140,33 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
                 positions[:, i, j] = values[("mounts", i, "position", j)]
         if any(("mounts", i, key) in values for key in ("k_axial", "k_shear")):
             get = lambda key: values.get(("mounts", i, key), getattr(mount, key))  # noqa: E731,B023
-            stiffness[:, i, :3, :3] = axial_shear_matrix(_unit(mount.axis), get("k_axial"), get("k_shear"))
+            stiffness[:, i, :3, :3] = axial_shear_matrix(unit_vector(mount.axis, f"mounts[{i}].axis"), get("k_axial"), get("k_shear"))
     operating = values.get(("thrust", "operating"), np.full(n, np.nan if pk.operating is None else pk.operating))
     t_max = doc.analysis.thrust_max
     thrust_max = np.full(n, float(t_max)) if t_max is not None else 10.0 * operating
     arms = np.concatenate([np.linalg.norm(positions, axis=-1), np.full((n, 1), np.linalg.norm(pk.r_thrust))], axis=1)
     length_scale = np.maximum(arms.max(axis=1), 1e-3)
-    rep = lambda a: np.repeat(np.asarray(a, dtype=float)[None], n, axis=0)  # noqa: E731
     # the model rule "the mounts restrain all six motions", on the condensed stiffness
     with np.errstate(invalid="ignore", over="ignore"):
         ev = np.linalg.eigvalsh(np.nan_to_num(condense(positions, stiffness)))
     bad |= ~(ev[:, 0] > _RESTRAINT_MARGIN * ev[:, -1])
     good = np.flatnonzero(~bad)
+    stiff = stiffness[good]
+    rep = lambda a: np.repeat(np.asarray(a, dtype=float)[None], len(good), axis=0)  # noqa: E731
     mass, _, k0, k1, _, affine = affine_forms(
-        rep(pk.mass6)[good], rep(pk.damp6)[good], positions[good], stiffness[good], np.zeros_like(stiffness[good]),
-        rep(pk.e_dir)[good], rep(pk.r_thrust)[good], np.full(len(good), pk.tangency), pk.preload,
-        length_scale[good], model.analysis.linearization == "equilibrium",
+        rep(pk.mass6), rep(pk.damp6), positions[good], stiff, np.zeros_like(stiff), rep(pk.e_dir), rep(pk.r_thrust),
+        np.full(len(good), pk.tangency), pk.preload, length_scale[good], model.analysis.linearization == "equilibrium",
     )
     designs: list[AffineDesign | None] = [None] * n
     for r in np.flatnonzero(affine):
         j = int(good[r])
         designs[j] = AffineDesign(
             mass[r], k0[r], k1[r], float(thrust_max[j]), float(operating[j]),
-            _Factory(base, segments, [c[j] for c in columns], name),
+            functools.partial(_variant_family, base, segments, [c[j] for c in columns], name),
         )
     return BulkDesigns(designs)
 
 
-class _Factory:
+def _variant_family(base: dict, segments, values, name: str) -> ModelFamily:
     """The family of one design, assembled the per-variant way (only if its engine is needed)."""
-
-    def __init__(self, base: dict, segments, values, name: str) -> None:
-        self.base, self.segments, self.values, self.name = base, segments, values, name
-
-    def __call__(self) -> ModelFamily:
-        vals = [v.item() if isinstance(v, np.generic) else v for v in self.values]
-        return ModelFamily(model_from_dict(set_values(self.base, [tuple(s) for s in self.segments], vals), name=self.name))
-
-
-def _unit(vec) -> Array:
-    v = np.asarray(vec, dtype=float)
-    return v / float(np.linalg.norm(v))
+    return ModelFamily(model_from_dict(variant_dict(base, segments, values), name=name))

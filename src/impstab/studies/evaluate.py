@@ -19,7 +19,7 @@ from ..errors import ModelError
 from ..linear.batch import STATUSES, critical_thrust_batch
 from ..model.assemble import model_from_dict
 from .bulk import assemble_bulk
-from .paths import set_values
+from .paths import variant_dict
 
 __all__ = ["ChunkTask", "ChunkResult", "evaluate_chunk", "variant_dict", "CODE_OUTPUTS"]
 
@@ -68,12 +68,6 @@ class ChunkResult:
     @property
     def size(self) -> int:
         return int(self.data["status"].size)
-
-
-def variant_dict(base: dict, segments, values) -> dict:
-    """The model-file dict of one design: ``base`` with each path set to its value."""
-    vals = [v.item() if isinstance(v, np.generic) else v for v in values]
-    return set_values(base, [tuple(s) for s in segments], vals)
 
 
 def evaluate_chunk(task: ChunkTask) -> ChunkResult:

@@ -15,11 +15,12 @@ import typing
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal, Union
 
+import numpy as np
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
 from ..model.schema import ModelFile
 
-__all__ = ["ParameterPath", "parse_path", "resolve_path", "set_values"]
+__all__ = ["ParameterPath", "parse_path", "resolve_path", "set_values", "variant_dict"]
 
 _SEGMENT = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
 _FROZEN = ("schema_version", "name")
@@ -188,3 +189,9 @@ def set_values(base: dict, paths: list, values: list[Any]) -> dict:
             cur = child
         cur[segs[-1]] = val
     return root
+
+
+def variant_dict(base: dict, segments, values) -> dict:
+    """The model-file dict of one design: ``base`` with each path set to its value."""
+    vals = [v.item() if isinstance(v, np.generic) else v for v in values]
+    return set_values(base, [tuple(s) for s in segments], vals)

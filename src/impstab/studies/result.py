@@ -163,7 +163,7 @@ class StudyResult:
         """
         import tomllib
 
-        from .evaluate import variant_dict
+        from .paths import variant_dict
         from .paths import parse_path
 
         unknown = [p for p in parameters if p not in self.parameters]
