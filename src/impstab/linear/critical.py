@@ -197,9 +197,9 @@ class _Engine:
         return unstable_masks(vals, self.undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR)
 
     def _classify_ops(self, ops: Array) -> tuple[Array, Array]:
-        return self.classify_eigenvalues(eigvals_small(ops))
+        return self.classify_values(eigvals_small(ops))
 
-    def classify_eigenvalues(self, vals: Array) -> tuple[Array, Array]:
+    def classify_values(self, vals: Array) -> tuple[Array, Array]:
         """Stability flags and indicators of problems with eigenvalues ``vals (N, n)``.
 
         Indicator column 0: closest approach of two frequencies; column 1: smallest s (distance

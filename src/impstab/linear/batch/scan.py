@@ -31,7 +31,7 @@ def _classify_group(jobs: list[_Job], start: int, stop: int) -> list:
             a1 = np.stack([j.a1 for j in jobs])
             p = np.stack([j.grid[start:stop] for j in jobs])
             vals = eigvals_affine(a0, a1, p)
-            flags, ind = _Stack(None, True).classify_eigenvalues(vals.reshape(-1, vals.shape[-1]))
+            flags, ind = _Stack(None, True).classify_values(vals.reshape(-1, vals.shape[-1]))
         else:
             ops = np.stack([j.engine().operators(j.grid[start:stop])[0] for j in jobs])
             flat = ops.reshape((-1,) + ops.shape[2:])
@@ -143,9 +143,6 @@ def _brackets(jobs: list[_Job], errors: dict) -> list:
             if hit is not None:
                 out[r] = (jobs[r].grid[j - 1], hit)
                 del pos[r]
-    for r in range(len(jobs)):
-        if id(jobs[r]) in errors:
-            out[r] = None
     return out
 
 
