@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import optimize
 
-from .eigen import kinetic_shares, state_matrices
+from .eigen import cluster_participation, kinetic_shares, state_matrices
 from .families import CallableFamily, LinearFamily, SystemFamily
 from .classify import classify_eigenvalues, unstable_masks
 from .small_eig import eigvals_small
@@ -481,14 +481,14 @@ class _Engine:
             j = members[np.argmax(v.real)]
             omega = 0.0 if divergence else float(abs(vals[j].imag))
             mode = vecs[:n, j]
-        shapes = vecs[:n, members]
+        shapes, values = vecs[:n, members], vals[members]
         if proj is not None and before is not None:
             vals_b, vecs_b, _ = self.decompose(before)
             sel, ok = self.select(vecs_b, proj, len(members))
             if ok:
-                shapes = vecs_b[:n, sel]
-        # each mode of the cluster weighs equally in the participation
-        part = np.mean([kinetic_shares(shapes[:, [j]], m) for j in range(shapes.shape[1])], axis=0)
+                shapes, values = vecs_b[:n, sel], vals_b[sel]
+        # each distinct mode of the cluster weighs equally in the participation
+        part = cluster_participation(shapes, values, np.ones(len(values), dtype=bool), np.diag(m), TOL_DUPLICATE)
         kind = "divergence" if divergence else "flutter"
         big = np.argmax(np.abs(mode))
         mode = mode * np.conj(mode[big]) / np.abs(mode[big]) ** 2

@@ -37,8 +37,13 @@ _MAX_ITERATIONS = 60  # per eigenvalue, as EISPACK hqr (30 per eigenvalue in dla
 
 
 @njit(cache=True)
-def _balance(a, n):
-    """Scale rows and columns by powers of two until their off-diagonal norms are comparable."""
+def _balance(a, n, f):
+    """Scale rows and columns by powers of two until their off-diagonal norms are comparable.
+
+    The result is ``D^-1 a D`` with ``D = diag(f)``; ``f`` (length ``n``) receives the scaling.
+    """
+    for i in range(n):
+        f[i] = 1.0
     done = False
     while not done:
         done = True
@@ -52,22 +57,23 @@ def _balance(a, n):
             if c == 0.0 or r == 0.0:
                 continue
             total = c + r
-            f = 1.0
+            step = 1.0
             g = r / 2.0
             while c < g:
-                f *= 2.0
+                step *= 2.0
                 c *= 4.0
             g = r * 2.0
             while c > g:
-                f /= 2.0
+                step /= 2.0
                 c /= 4.0
-            if (c + r) / f < 0.95 * total:
+            if (c + r) / step < 0.95 * total:
                 done = False
-                g = 1.0 / f
+                f[i] *= step
+                g = 1.0 / step
                 for j in range(n):
                     a[i, j] *= g
                 for j in range(n):
-                    a[j, i] *= f
+                    a[j, i] *= step
 
 
 @njit(cache=True)
@@ -251,7 +257,7 @@ def _solve_one(a, n, v, wr, wi, out_row):
         for j in range(n):
             if not np.isfinite(a[i, j]):
                 return False
-    _balance(a, n)
+    _balance(a, n, v)  # v: scratch for the scaling, then for the reflections
     _hessenberg(a, n, v)
     ok = _francis(a, n, wr, wi)
     for i in range(n):

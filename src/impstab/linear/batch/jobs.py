@@ -9,6 +9,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from ..blocks import decoupled_blocks
 from ..critical import _Engine
 from ..linearize import ModelFamily
 
@@ -178,4 +179,14 @@ class _Job:
         return self.engine().operators(np.array([x]))[0]
 
 
-# -- batched scan -----------------------------------------------------------------------------
+def gather(jobs: list[_Job]) -> tuple:
+    """``a0, a1`` stacks and block structure of affine jobs (rows of their shared pack)."""
+    pack = jobs[0].pack
+    if all(j.pack is pack for j in jobs):
+        rows = np.array([j.row for j in jobs])
+        return pack[0][rows], pack[1][rows], pack[2].take(rows)
+    a0, a1 = np.stack([j.a0 for j in jobs]), np.stack([j.a1 for j in jobs])
+    return a0, a1, decoupled_blocks(a0, a1, np.array([j.p_max for j in jobs]))
+
+
+

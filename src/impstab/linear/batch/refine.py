@@ -5,26 +5,14 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..critical import FLOOR, TOL_CLUSTER
-from .jobs import _EPS4, _Job, _Stack
+from ..blocks import eig_affine
+from ..critical import FLOOR, TOL_CLUSTER, TOL_DUPLICATE
+from ..eigen import cluster_participation
+from .jobs import _EPS4, _Job, _Stack, gather
 from .scan import _brackets
 
 Array = NDArray[np.float64]
 
-
-
-def _inv(m: Array) -> tuple[Array, NDArray[np.bool_]]:
-    """Inverses of a stack, and which exist (a singular one is NaN, left to its engine)."""
-    try:
-        return np.linalg.inv(m), np.ones(len(m), dtype=bool)
-    except np.linalg.LinAlgError:
-        out, ok = np.full(m.shape, np.nan, dtype=m.dtype), np.ones(len(m), dtype=bool)
-        for i, mi in enumerate(m):
-            try:
-                out[i] = np.linalg.inv(mi)
-            except np.linalg.LinAlgError:
-                ok[i] = False
-        return out, ok
 
 
 def _select(vecs: Array, proj: Array, k: NDArray) -> tuple[NDArray, NDArray]:
@@ -44,16 +32,16 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
     n = len(jobs)
     a = np.array([br[0] for br in brackets])
     b = np.array([br[1] for br in brackets])
-    a0, a1 = np.stack([j.a0 for j in jobs]), np.stack([j.a1 for j in jobs])
-    op = lambda p: a0 + p[:, None, None] * a1  # noqa: E731
+    a0, a1, blocks = gather(jobs)
 
     def eig(p, rows):
-        ops = op(p) if rows is None else a0[rows] + p[:, None, None] * a1[rows]
-        vals, vecs = np.linalg.eig(ops)
-        return vals.astype(complex), vecs.astype(complex)
+        """Eigenvalues, unit eigenvectors, their inverse and where these exist (else NaN)."""
+        if rows is None:
+            return eig_affine(a0, a1, p, blocks)
+        return eig_affine(a0[rows], a1[rows], p, blocks.take(rows))
 
     evals = np.full(n, 2)
-    vals_b, vecs_b = eig(b, None)
+    vals_b, vecs_b, inv_b, good = eig(b, None)
     cplx, neg = _Stack(None, True).unstable_parts(vals_b)
     bad = cplx | neg
     has_c = cplx.any(-1)
@@ -63,13 +51,12 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
     members = (np.abs(vals_b - ref) <= tol) | (np.abs(vals_b - np.conj(ref)) <= tol)
     divergence = ~has_c
     k = members.sum(-1)
-    inv_b, good = _inv(vecs_b)
     proj = (vecs_b * members[:, None, :]) @ inv_b
-    vals_a, vecs_a = eig(a, None)
+    vals_a, vecs_a, _, fine_a = eig(a, None)
     _, ok_a = _select(vecs_a, proj, k)
-    good &= bad.any(-1) & ~(bad & ~members).any(-1) & ok_a
+    good &= bad.any(-1) & ~(bad & ~members).any(-1) & ok_a & fine_a
 
-    def indicator(vals, vecs, rows, derivative):
+    def indicator(vals, vecs, inv, fine, rows, derivative):
         sel, ok = _select(vecs, proj[rows], k[rows])
         kk, dv = k[rows], divergence[rows]
         v = np.where(sel, vals, 0)
@@ -77,14 +64,13 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
         f = np.where(dv, s1.real / kk, (kk * s2 - s1**2).real)
         if not derivative:
             return f, ok
-        inv, fine = _inv(vecs)
         bd = np.einsum("dij,djk,dki->di", inv, a1[rows], vecs)
         bd = np.where(sel, bd, 0)
         df = np.where(dv, bd.real.sum(-1) / kk, (2 * kk * (v * bd).sum(-1) - 2 * s1 * bd.sum(-1)).real)
         return f, df, ok & fine
 
-    fa, oka = indicator(vals_a, vecs_a, slice(None), False)
-    fb, okb = indicator(vals_b, vecs_b, slice(None), False)
+    fa, oka = indicator(vals_a, vecs_a, None, fine_a, slice(None), False)
+    fb, okb = indicator(vals_b, vecs_b, inv_b, good, slice(None), False)
     good &= oka & okb & ((fa == 0) | (np.sign(fa) != np.sign(fb)))
     root = np.where(fa == 0, a, np.nan)
     live = np.flatnonzero(good & (fa != 0))
@@ -94,9 +80,9 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
     for _ in range(100):
         if not live.size:
             break
-        vals, vecs = eig(p[live], live)
+        vals, vecs, inv, fine = eig(p[live], live)
         evals[live] += 1
-        f, df, ok = indicator(vals, vecs, live, True)
+        f, df, ok = indicator(vals, vecs, inv, fine, live, True)
         good[live[~ok]] = False
         done = ok & (f == 0)
         root[live[done]] = p[live[done]]
@@ -119,13 +105,13 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
         j.evaluations += int(e)
     if not rows.size:
         return out
-    vals, vecs = eig(root[rows], rows)
+    vals, vecs, _, _ = eig(root[rows], rows)
     sel, _ = _select(vecs, proj[rows], k[rows])
     sel_a, ok_sa = _select(vecs_a[rows], proj[rows], k[rows])
     shapes, cols = np.where(ok_sa[:, None, None], vecs_a[rows], vecs), np.where(ok_sa[:, None], sel_a, sel)
-    w = (np.abs(shapes) ** 2) * np.stack([np.diag(jobs[r].mass) for r in rows])[:, :, None]
-    w = w / np.where(w.sum(-2, keepdims=True) > 0, w.sum(-2, keepdims=True), 1.0)
-    part = (w * cols[:, None, :]).sum(-1) / k[rows][:, None]
+    values = np.where(ok_sa[:, None], vals_a[rows], vals)
+    mass = np.stack([np.diag(jobs[r].mass) for r in rows])
+    part = cluster_participation(shapes, values, cols, mass, TOL_DUPLICATE)
     mean = np.where(sel, vals.real, 0).sum(-1) / k[rows]
     for i, r in enumerate(rows):
         div = bool(divergence[r])

@@ -6,31 +6,36 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..critical import TOL_DUPLICATE, TOL_UNSTABLE
-from ..small_eig import eigvals_affine
-from .jobs import _Job, _Stack
+from ..blocks import decoupled_blocks, eig_affine, eigvals_affine_blocks
+from .jobs import _Job, _Stack, gather
 
 Array = NDArray[np.float64]
 
 
 
 def _operators(jobs: list[_Job]) -> None:
-    """``a0 = M^-1 K0`` and ``a1 = M^-1 K1`` of the affine undamped jobs, as the engine forms them."""
+    """``a0 = M^-1 K0`` and ``a1 = M^-1 K1`` of the affine undamped jobs, as the engine forms them.
+
+    Also their decoupled blocks (:mod:`impstab.linear.blocks`) on each job's thrust range; the
+    stacks are shared by the jobs (:func:`gather`), each job keeping its row.
+    """
     fast = [j for j in jobs if j.fast]
     if not fast:
         return
     m = np.stack([j.mass for j in fast])
     a = np.linalg.solve(np.concatenate([m, m]), np.concatenate([np.stack([j.k0 for j in fast]), np.stack([j.k1 for j in fast])]))
+    a0, a1 = a[: len(fast)], a[len(fast):]
+    pack = (a0, a1, decoupled_blocks(a0, a1, np.array([j.p_max for j in fast])))
     for i, j in enumerate(fast):
-        j.a0, j.a1 = a[i], a[len(fast) + i]
+        j.a0, j.a1, j.pack, j.row = a0[i], a1[i], pack, i
 
 
 def _classify_group(jobs: list[_Job], start: int, stop: int) -> list:
     try:
-        if jobs[0].fast:  # the operators a0 + p a1 are formed one at a time in the kernel
-            a0 = np.stack([j.a0 for j in jobs])
-            a1 = np.stack([j.a1 for j in jobs])
+        if jobs[0].fast:  # the operators a0 + p a1 are formed one at a time in the kernel, block by block
+            a0, a1, blocks = gather(jobs)
             p = np.stack([j.grid[start:stop] for j in jobs])
-            vals = eigvals_affine(a0, a1, p)
+            vals = eigvals_affine_blocks(a0, a1, p, blocks)
             flags, ind = _Stack(None, True).classify_values(vals.reshape(-1, vals.shape[-1]))
         else:
             ops = np.stack([j.engine().operators(j.grid[start:stop])[0] for j in jobs])
@@ -151,7 +156,9 @@ def _attract_any(jobs: list[_Job], where: list[tuple[int, int]], errors: dict) -
     out = np.zeros(len(where), dtype=bool)
     fast = [k for k, (r, _) in enumerate(where) if jobs[r].fast]
     if fast:
-        out[fast] = _attracting([jobs[where[k][0]] for k in fast], [where[k][1] for k in fast])
+        out[fast], fine = _attracting([jobs[where[k][0]] for k in fast], [where[k][1] for k in fast])
+        for k in np.asarray(fast)[~fine]:  # as the engine's own test raises there
+            errors[id(jobs[where[k][0]])] = np.linalg.LinAlgError("Singular matrix")
     for k, (r, j) in enumerate(where):
         if jobs[r].fast or id(jobs[r]) in errors:
             continue
@@ -266,17 +273,21 @@ def _bounded_minimum(x1: float, x2: float, xatol: float, maxfun: int = 500):
             return
 
 
-def _attracting(jobs: list[_Job], js: list[int]) -> NDArray[np.bool_]:
-    """The engine's ``attracting(grid[j-1], grid[j], grid[j+1])`` for many jobs at once."""
+def _attracting(jobs: list[_Job], js: list[int]) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+    """The engine's ``attracting(grid[j-1], grid[j], grid[j+1])`` for many jobs at once.
+
+    Also returns where the test could be made (False: singular eigenvectors, where the engine's
+    own test raises).
+    """
     lo = np.array([jb.grid[j - 1] for jb, j in zip(jobs, js)])
     mid = np.array([jb.grid[j] for jb, j in zip(jobs, js)])
     hi = np.array([jb.grid[j + 1] for jb, j in zip(jobs, js)])
-    a0, a1 = np.stack([jb.a0 for jb in jobs]), np.stack([jb.a1 for jb in jobs])
+    a0, a1, blocks = gather(jobs)
     for jb in jobs:
         jb.evaluations += 3
     op = lambda p: a0 + p[:, None, None] * a1  # noqa: E731
-    vals, vecs = np.linalg.eig(op(mid))
-    vals, vecs = vals.astype(complex), vecs.astype(complex)
+    vals, vecs, inv, fine = eig_affine(a0, a1, mid, blocks)
+    vals, vecs, inv = (np.where(fine.reshape((-1,) + (1,) * (x.ndim - 1)), x, 0) for x in (vals, vecs, inv))
     result = np.abs(vals.imag).max(-1) > TOL_UNSTABLE * np.abs(vals).max(-1)
     order = np.argsort(vals.real, axis=-1)
     re = np.take_along_axis(vals.real, order, -1)
@@ -290,7 +301,7 @@ def _attracting(jobs: list[_Job], js: list[int]) -> NDArray[np.bool_]:
     np.put_along_axis(lower, order, lower_s, -1)
     np.put_along_axis(upper, order, upper_s, -1)
     rate = (op(hi) - op(lo)) / (hi - lo)[:, None, None]
-    b = np.linalg.solve(vecs, rate.astype(complex) @ vecs)
+    b = inv @ (rate @ vecs)
     norm = np.maximum(np.abs(rate).max(axis=(-2, -1)), 1e-300)
     # the interaction B_lu B_ul of the two clusters, a k_l x k_l block (the engine's product),
     # for all rows with the same cluster sizes at once
@@ -306,4 +317,4 @@ def _attracting(jobs: list[_Job], js: list[int]) -> NDArray[np.bool_]:
         prod = b_lu @ b_ul
         inter = prod[:, 0, :] if kl == 1 else np.linalg.eigvals(prod)
         pulled[rows] = np.any(inter.real < -1e-8 * norm[rows, None] ** 2, axis=-1)
-    return np.where(result, True, distinct.any(-1) & pulled)
+    return np.where(result, True, distinct.any(-1) & pulled) & fine, fine

@@ -1,0 +1,356 @@
+"""Decoupled blocks of affine operator families ``A(p) = A0 + p A1``, and their eigenproblems.
+
+A rigid body on a symmetric mount layout, with its thrust on the axis, falls apart into
+independent motions: surge, roll, and the sway-yaw and heave-pitch planes (the paper's
+Figure 4). Its operators ``M^-1 K(p)`` are then block diagonal after a permutation of the dofs,
+and the eigen-decomposition of the whole is that of each block: closed forms for blocks of one
+and two dofs, the compiled small-matrix routine (:mod:`impstab.linear.small_eig`) for larger ones.
+Design studies solve millions of such eigenproblems, so the batched critical-thrust engine uses
+this decomposition wherever a design has it.
+
+Which dofs are coupled
+----------------------
+Assembled in floating point, the coupling terms that vanish by symmetry are not exactly zero
+but rounding residues (``1e-17`` of the matrix norm in the bundled example: sums of
+``k y_i z_i`` over a ring). Two dofs ``i, j`` are coupled when, anywhere on the load range
+``[0, p_max]``, an entry ``A_ij`` or ``A_ji`` exceeds :data:`TOL_DECOUPLE` times the largest
+entry of the operator, all judged on the operators balanced by a power-of-two diagonal
+similarity (so that the mixed units of translations and rotations do not matter). Dropping what
+is below is a perturbation of at most ``n TOL_DECOUPLE`` of the operator's norm: within the
+backward error of LAPACK's own ``geev`` on the full matrix (a few ``eps |A|``). The eigenvalues
+are therefore as accurate as LAPACK's (simple ones to ``eps |A| / s_i``, a defective double one
+to ``sqrt(eps |A|)``), and the symmetric functions of a cluster that the engine refines on to
+``eps``.
+
+Conventions
+-----------
+Eigenvalues of a block are listed together; eigenvectors are unit columns (2-norm), the
+``k``-th column belonging to the ``k``-th eigenvalue; the returned inverse is the matrix of left
+eigenvectors ``V^-1``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import copysign, sqrt
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from .small_eig import _balance, _solve_one, eigvals_affine
+
+__all__ = ["BlockStructure", "TOL_DECOUPLE", "decoupled_blocks", "eigvals_affine_blocks", "eig_affine"]
+
+_EPS = float(np.finfo(float).eps)
+#: coupling (relative to the balanced operator's largest entry) below which dofs are decoupled
+TOL_DECOUPLE = 16.0 * _EPS
+
+
+@dataclass(frozen=True, eq=False)
+class BlockStructure:
+    """The independent blocks of each design's operators.
+
+    Attributes
+    ----------
+    order : (N, n) int array
+        The dofs of each design listed block by block (blocks by their first dof).
+    starts : (N, n + 1) int array
+        Start of block ``b`` in ``order`` at ``starts[:, b]``; ``starts[:, nblocks] = n`` and the
+        entries after it are ``n`` too.
+    nblocks : (N,) int array
+        Number of blocks.
+    largest : (N,) int array
+        Size of the largest block (1 for a diagonal operator, ``n`` for a coupled one).
+    """
+
+    order: NDArray[np.int64]
+    starts: NDArray[np.int64]
+    nblocks: NDArray[np.int64]
+    largest: NDArray[np.int64]
+
+    def take(self, rows: NDArray) -> "BlockStructure":
+        """The structure of the designs ``rows``."""
+        return BlockStructure(self.order[rows], self.starts[rows], self.nblocks[rows], self.largest[rows])
+
+
+@njit(cache=True)
+def _structure(a0, a1, p_max, tol, order, starts, nblocks, largest):
+    count, n = a0.shape[0], a0.shape[1]
+    c = np.empty((n, n))
+    f = np.empty(n)
+    label = np.empty(n, dtype=np.int64)
+    for s in range(count):
+        for i in range(n):
+            for j in range(n):
+                c[i, j] = abs(a0[s, i, j]) + abs(p_max[s]) * abs(a1[s, i, j])
+        _balance(c, n, f)
+        # the operator's size at both ends of the range, in the balanced units
+        end0 = 0.0
+        end1 = 0.0
+        finite = np.isfinite(p_max[s])
+        for i in range(n):
+            for j in range(n):
+                w = f[j] / f[i]
+                end0 = max(end0, abs(a0[s, i, j]) * w)
+                end1 = max(end1, abs(a0[s, i, j] + p_max[s] * a1[s, i, j]) * w)
+                finite = finite and np.isfinite(a0[s, i, j]) and np.isfinite(a1[s, i, j])
+        limit = tol * min(end0, end1)
+        finite = finite and np.isfinite(limit)
+        for i in range(n):
+            label[i] = i
+        changed = True
+        while changed:  # connected components: propagate the smallest label
+            changed = False
+            for i in range(n):
+                for j in range(i + 1, n):
+                    if not finite or c[i, j] > limit or c[j, i] > limit:
+                        m = min(label[i], label[j])
+                        if label[i] != m or label[j] != m:
+                            label[i] = m
+                            label[j] = m
+                            changed = True
+        k = 0
+        b = 0
+        big = 0
+        for root in range(n):
+            first = k
+            for i in range(n):
+                if label[i] == root:
+                    order[s, k] = i
+                    k += 1
+            if k > first:
+                starts[s, b] = first
+                b += 1
+                big = max(big, k - first)
+        for r in range(b, n + 1):
+            starts[s, r] = n
+        nblocks[s] = b
+        largest[s] = big
+
+
+def decoupled_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], p_max: NDArray[np.float64]) -> BlockStructure:
+    """The independent blocks of ``A0[i] + p A1[i]`` on ``0 <= p <= p_max[i]``.
+
+    Parameters
+    ----------
+    a0, a1 : (N, n, n) float arrays
+    p_max : (N,) float array
+        End of each design's load range.
+
+    Returns
+    -------
+    BlockStructure
+        A design whose operators are not finite is one block.
+    """
+    a0 = np.ascontiguousarray(a0, dtype=float)
+    a1 = np.ascontiguousarray(a1, dtype=float)
+    count, n = a0.shape[0], a0.shape[-1]
+    order = np.empty((count, n), dtype=np.int64)
+    starts = np.empty((count, n + 1), dtype=np.int64)
+    nblocks = np.empty(count, dtype=np.int64)
+    largest = np.empty(count, dtype=np.int64)
+    _structure(a0, a1, np.ascontiguousarray(p_max, dtype=float), TOL_DECOUPLE, order, starts, nblocks, largest)
+    return BlockStructure(order, starts, nblocks, largest)
+
+
+@njit(cache=True)
+def _values2(a, b, c, d):
+    """Eigenvalues of ``[[a, b], [c, d]]`` (LAPACK ``dlanv2``'s standardisation, unscaled)."""
+    p = 0.5 * (a - d)
+    bc = b * c
+    q = p * p + bc
+    if q >= 0.0:
+        z = p + copysign(sqrt(q), p)
+        if z == 0.0:
+            return complex(d, 0.0), complex(d, 0.0)
+        return complex(d + z, 0.0), complex(d - bc / z, 0.0)
+    m = 0.5 * (a + d)
+    w = sqrt(-q)
+    return complex(m, w), complex(m, -w)
+
+
+@njit(cache=True)
+def _vector2(lam, a, b, c, d, first):
+    """Unit eigenvector of ``[[a, b], [c, d]]`` for ``lam``: the larger of the two row solutions."""
+    x1, y1 = complex(b, 0.0), lam - a
+    x2, y2 = lam - d, complex(c, 0.0)
+    n1 = x1.real**2 + x1.imag**2 + y1.real**2 + y1.imag**2
+    n2 = x2.real**2 + x2.imag**2 + y2.real**2 + y2.imag**2
+    if n1 >= n2 and n1 > 0.0:
+        s = 1.0 / sqrt(n1)
+        return x1 * s, y1 * s
+    if n2 > 0.0:
+        s = 1.0 / sqrt(n2)
+        return x2 * s, y2 * s
+    # a multiple of the identity: any basis
+    if first:
+        return complex(1.0, 0.0), complex(0.0, 0.0)
+    return complex(0.0, 0.0), complex(1.0, 0.0)
+
+
+@njit(cache=True)
+def _eigvals_blocks(a0, a1, loads, order, starts, nblocks, out, ok):
+    count, n = a0.shape[0], a0.shape[1]
+    w = np.empty((n, n))
+    v, wr, wi = np.empty(n), np.empty(n), np.empty(n)
+    for s in range(count):
+        for k in range(loads.shape[1]):
+            p = loads[s, k]
+            good = True
+            for b in range(nblocks[s]):
+                lo, hi = starts[s, b], starts[s, b + 1]
+                m = hi - lo
+                if m == 1:
+                    r = order[s, lo]
+                    out[s, k, lo] = complex(a0[s, r, r] + p * a1[s, r, r], 0.0)
+                elif m == 2:
+                    i, j = order[s, lo], order[s, lo + 1]
+                    l1, l2 = _values2(a0[s, i, i] + p * a1[s, i, i], a0[s, i, j] + p * a1[s, i, j],
+                                      a0[s, j, i] + p * a1[s, j, i], a0[s, j, j] + p * a1[s, j, j])
+                    out[s, k, lo] = l1
+                    out[s, k, lo + 1] = l2
+                else:
+                    for x in range(m):
+                        for y in range(m):
+                            i, j = order[s, lo + x], order[s, lo + y]
+                            w[x, y] = a0[s, i, j] + p * a1[s, i, j]
+                    good = _solve_one(w, m, v, wr, wi, out[s, k, lo:hi]) and good
+            for i in range(n):
+                good = good and np.isfinite(out[s, k, i].real) and np.isfinite(out[s, k, i].imag)
+            ok[s, k] = good
+
+
+def eigvals_affine_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[np.float64],
+                          blocks: BlockStructure) -> NDArray[np.complex128]:
+    """Eigenvalues of ``a0[i] + loads[i, k] a1[i]``, block by block; shape ``(N, K, n)``.
+
+    The same values as :func:`impstab.linear.small_eig.eigvals_affine` to rounding (see the
+    module notes); a problem whose blocks fail (not finite, no convergence) is solved whole by it.
+    """
+    a0 = np.ascontiguousarray(a0, dtype=float)
+    a1 = np.ascontiguousarray(a1, dtype=float)
+    loads = np.ascontiguousarray(loads, dtype=float)
+    out = np.empty(loads.shape + (a0.shape[-1],), dtype=np.complex128)
+    ok = np.ones(loads.shape, dtype=np.bool_)
+    _eigvals_blocks(a0, a1, loads, blocks.order, blocks.starts, blocks.nblocks, out, ok)
+    if not ok.all():
+        s, k = np.nonzero(~ok)
+        out[s, k] = eigvals_affine(a0[s], a1[s], loads[s, k][:, None])[:, 0]
+    return out
+
+
+@njit(cache=True)
+def _eig_blocks(a0, a1, loads, order, starts, nblocks, vals, vecs, inv, ok):
+    """Eigen-decomposition of designs whose blocks have at most two dofs."""
+    count, n = a0.shape[0], a0.shape[1]
+    for s in range(count):
+        p = loads[s]
+        good = True
+        for x in range(n):
+            for y in range(n):
+                vecs[s, x, y] = 0.0
+                inv[s, x, y] = 0.0
+        for b in range(nblocks[s]):
+            lo, hi = starts[s, b], starts[s, b + 1]
+            if hi - lo == 1:
+                r = order[s, lo]
+                vals[s, lo] = complex(a0[s, r, r] + p * a1[s, r, r], 0.0)
+                vecs[s, r, lo] = 1.0
+                inv[s, lo, r] = 1.0
+                continue
+            if hi - lo != 2:
+                good = False
+                continue
+            i, j = order[s, lo], order[s, lo + 1]
+            a = a0[s, i, i] + p * a1[s, i, i]
+            bb = a0[s, i, j] + p * a1[s, i, j]
+            c = a0[s, j, i] + p * a1[s, j, i]
+            d = a0[s, j, j] + p * a1[s, j, j]
+            l1, l2 = _values2(a, bb, c, d)
+            v00, v10 = _vector2(l1, a, bb, c, d, True)
+            v01, v11 = _vector2(l2, a, bb, c, d, False)
+            det = v00 * v11 - v01 * v10
+            if det == 0.0 or not (np.isfinite(det.real) and np.isfinite(det.imag)):
+                good = False
+                continue
+            vals[s, lo] = l1
+            vals[s, lo + 1] = l2
+            vecs[s, i, lo] = v00
+            vecs[s, j, lo] = v10
+            vecs[s, i, lo + 1] = v01
+            vecs[s, j, lo + 1] = v11
+            inv[s, lo, i] = v11 / det
+            inv[s, lo, j] = -v01 / det
+            inv[s, lo + 1, i] = -v10 / det
+            inv[s, lo + 1, j] = v00 / det
+        ok[s] = good
+
+
+def _lapack(ops: NDArray[np.float64]) -> tuple:
+    """``np.linalg.eig`` and the inverse of the eigenvectors; rows that fail are NaN, not ok."""
+    count, n = ops.shape[0], ops.shape[-1]
+    vals = np.full((count, n), np.nan + 0j)
+    vecs = np.full((count, n, n), np.nan + 0j)
+    inv = np.full((count, n, n), np.nan + 0j)
+    ok = np.isfinite(ops).all(axis=(-2, -1))
+    rows = np.flatnonzero(ok)
+    if rows.size:
+        v, w = np.linalg.eig(ops[rows])
+        vals[rows], vecs[rows] = v, w
+        try:
+            inv[rows] = np.linalg.inv(vecs[rows])
+        except np.linalg.LinAlgError:
+            for r in rows:
+                try:
+                    inv[r] = np.linalg.inv(vecs[r])
+                except np.linalg.LinAlgError:
+                    ok[r] = False
+    return vals, vecs, inv, ok
+
+
+def eig_affine(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[np.float64],
+               blocks: BlockStructure | None = None) -> tuple:
+    """Eigenvalues, unit eigenvectors and their inverse of ``a0[i] + loads[i] a1[i]``.
+
+    Parameters
+    ----------
+    a0, a1 : (N, n, n) float arrays
+    loads : (N,) float array
+    blocks : BlockStructure, optional
+        Designs whose blocks have at most two dofs are solved in closed form; the others (and
+        all designs without a structure) by ``np.linalg.eig`` on the whole operator.
+
+    Returns
+    -------
+    vals : (N, n) complex array
+    vecs : (N, n, n) complex array
+        Unit columns; ``vecs[i] @ diag(vals[i]) = A_i vecs[i]``.
+    inv : (N, n, n) complex array
+        ``vecs[i]^-1`` (the left eigenvectors as rows).
+    ok : (N,) bool array
+        False where the operator is not finite or its eigenvectors are singular (an exactly
+        defective point): those rows are NaN.
+    """
+    a0 = np.ascontiguousarray(a0, dtype=float)
+    a1 = np.ascontiguousarray(a1, dtype=float)
+    loads = np.ascontiguousarray(loads, dtype=float)
+    count, n = a0.shape[0], a0.shape[-1]
+    small = np.zeros(count, dtype=bool) if blocks is None else blocks.largest <= 2
+    vals = np.empty((count, n), dtype=np.complex128)
+    vecs = np.empty((count, n, n), dtype=np.complex128)
+    inv = np.empty((count, n, n), dtype=np.complex128)
+    ok = np.zeros(count, dtype=np.bool_)
+    if small.any():
+        rows = np.flatnonzero(small)
+        sub = blocks.take(rows)
+        v, w, u, good = (np.empty((len(rows), n), np.complex128), np.empty((len(rows), n, n), np.complex128),
+                         np.empty((len(rows), n, n), np.complex128), np.zeros(len(rows), np.bool_))
+        _eig_blocks(a0[rows], a1[rows], loads[rows], sub.order, sub.starts, sub.nblocks, v, w, u, good)
+        vals[rows], vecs[rows], inv[rows], ok[rows] = v, w, u, good
+        small[rows[~good]] = False
+    rest = np.flatnonzero(~small)
+    if rest.size:
+        ops = a0[rest] + loads[rest, None, None] * a1[rest]
+        vals[rest], vecs[rest], inv[rest], ok[rest] = _lapack(ops)
+    return vals, vecs, inv, ok
