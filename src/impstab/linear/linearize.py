@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 from ..errors import ModelError, NumericalError
 from ..model.model import LINEARIZATIONS, Model
 from .system import LinearSystem
-from .tangent import classical_pairs, linearize_batch
+from .tangent import classical_forms, linearize_batch
 
 __all__ = ["linearize", "ModelFamily", "PackedModel", "pack_model", "affine_forms"]
 
@@ -93,26 +93,18 @@ def affine_forms(
     ``(n, 6, 6)``; ``G1`` per unit ``I_p Omega``) and ``affine (n,)``: whether K is exactly
     linear in T for that design.
 
-    The classical form is linear by construction. The equilibrium form is too when linear
-    statics leaves the body unrotated (symmetric layouts, thrust through the elastic centre):
-    then ``R0 = I`` solves the nonlinear statics exactly, the mount forces are the linear ones
-    and the tangent equals the classical matrices.
+    The classical form is linear by construction; its two parts are formed directly by
+    :func:`~impstab.linear.tangent.classical_forms` (the matrices of :func:`linearize_batch` to
+    rounding). The equilibrium form is linear too when linear statics leaves the body unrotated
+    (symmetric layouts, thrust through the elastic centre): then ``R0 = I`` solves the nonlinear
+    statics exactly, the mount forces are the linear ones and the tangent equals the classical
+    matrices. ``length_scale`` (m) converts that rotation to a displacement for the test.
     """
-    # K(T) is linear in the classical form: take K1 from a large thrust so that K0 does not
-    # cancel it (the kernel's K is computed linearly in T, so the difference is exact to eps)
-    big = 1e8 * np.maximum(np.abs(stiffness).max(axis=(1, 2, 3), initial=0.0), 1e-300) * length_scale
-    m, d, g, k = classical_pairs(
-        mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency, preload, big, length_scale
+    m, d, g, k0, k1, q0 = classical_forms(
+        mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, np.asarray(tangency, dtype=float), preload
     )
-    k0, k1 = k[:, 0], (k[:, 1] - k[:, 0]) / big[:, None, None]
     affine = np.ones(len(m), dtype=bool)
     if equilibrium:
-        e, r = e_dir, r_thrust
-        load = np.stack(
-            [e[:, 0], e[:, 1], e[:, 2], r[:, 1] * e[:, 2] - r[:, 2] * e[:, 1], r[:, 2] * e[:, 0] - r[:, 0] * e[:, 2],
-             r[:, 0] * e[:, 1] - r[:, 1] * e[:, 0]], axis=-1,
-        )
-        q0 = np.linalg.solve(k0, load[..., None])[..., 0]
         rot = np.abs(q0[:, 3:]).max(axis=-1) * length_scale
         affine = rot <= 1e-13 * np.maximum(np.abs(q0[:, :3]).max(axis=-1), 1e-300)
     return m, d, k0, k1, g, affine

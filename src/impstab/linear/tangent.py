@@ -24,7 +24,7 @@ from numba import njit
 
 from .so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _skew
 
-__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_pairs", "MAX_PREDICTOR"]
+__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_forms", "MAX_PREDICTOR"]
 
 #: largest accepted predictor step of the continuation (rad, or fraction of the length scale)
 MAX_PREDICTOR = 0.02
@@ -240,27 +240,153 @@ def linearize_batch(
 
 
 @njit(cache=True)
-def classical_pairs(mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency, preload, big, length_scale):
-    """``linearize_batch`` in the classical form at thrusts ``(0, big[i])`` for each design ``i``.
+def _skew_into(out, a):
+    """Write the cross-product matrix ``S(a)`` (``S(a) b = a x b``) into the 3x3 ``out``."""
+    out[0, 0] = 0.0
+    out[0, 1] = -a[2]
+    out[0, 2] = a[1]
+    out[1, 0] = a[2]
+    out[1, 1] = 0.0
+    out[1, 2] = -a[0]
+    out[2, 0] = -a[1]
+    out[2, 1] = a[0]
+    out[2, 2] = 0.0
 
-    Stacked inputs have a leading design axis (``positions (n, nm, 3)``, ...); returns ``M, D,
-    G (n, 6, 6)`` at zero thrust and ``K (n, 2, 6, 6)`` at both thrusts (unit spin, so that G
-    is the gyroscopic matrix per unit ``I_p Omega``).
+
+@njit(cache=True)
+def _add_skew_product(out, scale, sa, sb):
+    """``out[3:, 3:] += scale * sa @ sb`` for 3x3 ``sa, sb``."""
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for k in range(3):
+                acc += sa[i, k] * sb[k, j]
+            out[3 + i, 3 + j] += scale * acc
+
+
+@njit(cache=True)
+def _add_moved(out, mat, sr, work):
+    """``out += T^T mat T`` with ``T = [[I, -sr], [0, I]]``: a 6x6 mount matrix (N/m, N/rad,
+    N m/rad; or the damping analogues) at the mount end moved to the reference point A.
+
+    ``sr`` is ``S(r)`` of the mount position ``r`` (m); ``work`` is 6x6 scratch.
+    """
+    # work = mat @ T
+    for i in range(6):
+        for j in range(3):
+            work[i, j] = mat[i, j]
+            acc = 0.0
+            for k in range(3):
+                acc += mat[i, k] * sr[k, j]
+            work[i, 3 + j] = mat[i, 3 + j] - acc
+    # out += T^T work; the rows 3..5 of T^T are [S(r), I] (S(r) is skew)
+    for j in range(6):
+        for i in range(3):
+            out[i, j] += work[i, j]
+            out[3 + i, j] += sr[i, 0] * work[0, j] + sr[i, 1] * work[1, j] + sr[i, 2] * work[2, j] + work[3 + i, j]
+
+
+@njit(cache=True)
+def classical_forms(mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency, preload):
+    """The classical linearization ``K = K0 + T K1`` of many designs, formed directly.
+
+    The same matrices as :func:`linearize_batch` with ``equilibrium=False`` (undeformed
+    configuration, mount forces from linear statics), unit propeller spin and polar inertia,
+    written out for zero rotation and split into the parts constant and linear in the thrust
+    ``T``, without per-design allocations.
+
+    Parameters
+    ----------
+    mass6, damp6 : (n, 6, 6) arrays
+        Body-frame mass (kg, kg m, kg m^2) and fluid damping about A of each design.
+    positions : (n, nm, 3) array
+        Mount positions (m).
+    stiffness, damping : (n, nm, 6, 6) arrays
+        Mount stiffness (N/m, N/rad, N m/rad) and damping (N s/m, ...) at the mount ends.
+    e_dir, r_thrust : (n, 3) arrays
+        Thrust direction (unit) and point of application (m).
+    tangency : (n,) array
+        Follower fraction of the thrust (1 follower, 0 fixed direction).
+    preload : bool
+        Include the mount-preload (geometric) stiffness.
+
+    Returns
+    -------
+    m, d, g : (n, 6, 6) arrays
+        ``M``, ``D`` and ``G`` per unit ``I_p Omega`` (kg m^2/s per kg m^2/s).
+    k0 : (n, 6, 6) array
+        Stiffness at zero thrust, the condensed mount stiffness (N/m, N, N m/rad).
+    k1 : (n, 6, 6) array
+        Its rate per newton of thrust (1/m, 1, m).
+    q1 : (n, 6) array
+        Static displacement per newton of thrust from linear statics, ``K0^-1 [e; r_T x e]``
+        (m/N, rad/N).
     """
     n = mass6.shape[0]
+    nm = positions.shape[1]
     m = np.empty((n, 6, 6))
     d = np.empty((n, 6, 6))
-    g = np.empty((n, 6, 6))
-    k = np.empty((n, 2, 6, 6))
-    spins = np.ones(2)
-    for i in range(n):
-        thrusts = np.array([0.0, big[i]])
-        mi, di, gi, ki, _, _, _ = linearize_batch(
-            thrusts, spins, mass6[i], damp6[i], positions[i], stiffness[i], damping[i], e_dir[i], r_thrust[i],
-            tangency[i], preload, 1.0, False, length_scale[i],
-        )
-        m[i] = mi[0]
-        d[i] = di[0]
-        g[i] = gi[0]
-        k[i] = ki
-    return m, d, g, k
+    g = np.zeros((n, 6, 6))
+    k0 = np.empty((n, 6, 6))
+    k1 = np.empty((n, 6, 6))
+    q1 = np.empty((n, 6))
+    sr = np.empty((nm, 3, 3))
+    sa = np.empty((3, 3))
+    sb = np.empty((3, 3))
+    work = np.empty((6, 6))
+    load = np.empty(6)
+    e_t = np.empty(3)
+    gi = np.empty(6)
+    for c in range(n):
+        m[c] = mass6[c]
+        kc = k0[c]
+        kc[:] = 0.0
+        dc = d[c]
+        dc[:] = 0.0
+        for i in range(nm):
+            _skew_into(sr[i], positions[c, i])
+            _add_moved(kc, stiffness[c, i], sr[i], work)
+            _add_moved(dc, damping[c, i], sr[i], work)
+        dc += damp6[c]
+        # gyroscopic matrix of a unit angular momentum along the thrust axis
+        _skew_into(sa, e_dir[c])
+        for i in range(3):
+            for j in range(3):
+                g[c, 3 + i, 3 + j] = -sa[i, j]
+        # static displacement per unit thrust (linear statics at the undeformed configuration)
+        e = e_dir[c]
+        r = r_thrust[c]
+        load[:3] = e
+        load[3:] = _cross(r, e)
+        q = np.linalg.solve(kc, load)
+        q1[c] = q
+        # thrust load stiffness per unit thrust: [[0, S(tau e)], [0, -S(e) S(r_T) + S(r_T) S(tau e)]]
+        kt = k1[c]
+        kt[:] = 0.0
+        for i in range(3):
+            e_t[i] = tangency[c] * e[i]
+        _skew_into(sb, e_t)
+        for i in range(3):
+            for j in range(3):
+                kt[i, 3 + j] = sb[i, j]
+        _skew_into(sa, r)
+        _add_skew_product(kt, 1.0, sa, sb)
+        _skew_into(sb, e)
+        _add_skew_product(kt, -1.0, sb, sa)
+        if preload:
+            # mount preload per unit thrust: sum_i S(g_i[:3]) S(r_i) - 1/2 S(g_i[3:]), g_i = k_i T_i q
+            for i in range(nm):
+                for a in range(6):
+                    acc = 0.0
+                    for b in range(3):
+                        acc += stiffness[c, i, a, b] * (q[b] - (sr[i, b, 0] * q[3] + sr[i, b, 1] * q[4] + sr[i, b, 2] * q[5]))
+                    for b in range(3, 6):
+                        acc += stiffness[c, i, a, b] * q[b]
+                    gi[a] = acc
+                _skew_into(sa, gi[:3])
+                _add_skew_product(kt, 1.0, sa, sr[i])
+                _skew_into(sa, gi[3:])
+                for a in range(3):
+                    for b in range(3):
+                        kt[3 + a, 3 + b] -= 0.5 * sa[a, b]
+    return m, d, g, k0, k1, q1
