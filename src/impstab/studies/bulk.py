@@ -151,22 +151,25 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
         ev = np.linalg.eigvalsh(np.nan_to_num(condense(positions, stiffness)))
     bad |= ~(ev[:, 0] > _RESTRAINT_MARGIN * ev[:, -1])
     good = np.flatnonzero(~bad)
-    stiff = stiffness[good]
-    rep = lambda a: np.repeat(np.asarray(a, dtype=float)[None], len(good), axis=0)  # noqa: E731
+    if len(good) < n:
+        positions, stiffness, length_scale = positions[good], stiffness[good], length_scale[good]
+    n_good = len(good)
+    rep = lambda a: np.broadcast_to(np.asarray(a, dtype=float), (n_good, *np.shape(a)))  # noqa: E731
     mass, _, k0, k1, _, affine = affine_forms(
-        rep(pk.mass6), rep(pk.damp6), positions[good], stiff, np.zeros_like(stiff), rep(pk.e_dir), rep(pk.r_thrust),
-        np.full(len(good), pk.tangency), pk.preload, length_scale[good], model.analysis.linearization == "equilibrium",
+        rep(pk.mass6), rep(pk.damp6), positions, stiffness, rep(np.zeros(stiffness.shape[1:])), rep(pk.e_dir),
+        rep(pk.r_thrust), np.full(n_good, pk.tangency), pk.preload, length_scale,
+        model.analysis.linearization == "equilibrium",
     )
+    if not affine.all():
+        good, mass, k0, k1 = good[affine], mass[affine], k0[affine], k1[affine]
     designs: list[AffineDesign | None] = [None] * n
-    for r in np.flatnonzero(affine):
-        j = int(good[r])
-        designs[j] = AffineDesign(
-            mass[r], k0[r], k1[r], float(thrust_max[j]), float(operating[j]),
-            functools.partial(_variant_family, base, segments, [c[j] for c in columns], name),
-        )
+    for j, mj, k0j, k1j, tj, oj in zip(
+        good.tolist(), mass, k0, k1, thrust_max[good].tolist(), operating[good].tolist()
+    ):
+        designs[j] = AffineDesign(mj, k0j, k1j, tj, oj, functools.partial(_variant_family, base, segments, columns, j, name))
     return BulkDesigns(designs)
 
 
-def _variant_family(base: dict, segments, values, name: str) -> ModelFamily:
-    """The family of one design, assembled the per-variant way (only if its engine is needed)."""
-    return ModelFamily(model_from_dict(variant_dict(base, segments, values), name=name))
+def _variant_family(base: dict, segments, columns, j: int, name: str) -> ModelFamily:
+    """The family of design ``j``, assembled the per-variant way (only if its engine is needed)."""
+    return ModelFamily(model_from_dict(variant_dict(base, segments, [c[j] for c in columns]), name=name))
