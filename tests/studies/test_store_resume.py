@@ -181,3 +181,53 @@ def test_ctrl_c_keeps_finished_chunks(tmp_path, capsys, monkeypatch):
     history = json.loads(open_study(store).dataset.attrs["history"])
     assert history[0]["interrupted"] and history[1]["chunks_computed"] == len(_records(store)) - 2
     assert open_study(store).complete
+
+
+def test_a_failed_data_write_leaves_the_chunk_not_done(tmp_path, monkeypatch):
+    """If one of a chunk's data writes fails, its completion record is not written (the chunk
+    is recomputed on the next run), and writing it again completes it."""
+    from impstab.studies.evaluate import evaluate_chunk
+    from impstab.studies.execute import chunk_task
+    from impstab.studies.store import StudyStore
+
+    study = load_study(write_study(tmp_path, GRID_6x5))
+    plan = plan_chunks(study)
+    store = tmp_path / "f.zarr"
+    st = StudyStore.create_or_resume(study, plan, store)
+    res = evaluate_chunk(chunk_task(study, plan, 1))
+    real = zarr.Array.__setitem__
+
+    def failing(self, selection, value):
+        if self.basename == "status":
+            raise OSError("disk full")
+        return real(self, selection, value)
+
+    monkeypatch.setattr(zarr.Array, "__setitem__", failing)
+    with pytest.raises(OSError, match="disk full"):
+        st.write(res)
+    monkeypatch.undo()
+    assert not np.isfinite(_records(store)[:, 0]).any()
+    group = zarr.open_group(str(store), mode="r")
+    sl = plan.slices(1)
+    np.testing.assert_array_equal(group["critical_thrust"][sl], res.data["critical_thrust"])  # written before
+    assert (group["status"][sl] == -1).all()
+    st.write(res)
+    assert np.isfinite(_records(store)[:, 0]).sum() == 1 and _records(store)[1, 1] == 1.0
+
+
+def test_run_leaves_the_garbage_collector_as_it_found_it(tmp_path):
+    """run_study freezes the objects that exist before it for its duration, and only if the
+    caller has not frozen any itself."""
+    import gc
+
+    study = load_study(write_study(tmp_path, GRID_6x5))
+    assert gc.get_freeze_count() == 0
+    run_study(study, None)
+    assert gc.get_freeze_count() == 0
+    gc.freeze()
+    try:
+        frozen = gc.get_freeze_count()
+        run_study(study, None)
+        assert gc.get_freeze_count() > frozen // 2  # still frozen (some frozen objects died meanwhile)
+    finally:
+        gc.unfreeze()

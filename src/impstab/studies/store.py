@@ -75,6 +75,7 @@ class StudyStore:
         self.plan = plan
         self.path = path
         self._arrays: dict = {}  # the result arrays, opened once
+        self._records: np.ndarray | None = None  # the progress records as last read or written
 
     # -- creation and resumption -------------------------------------------------------------
     @classmethod
@@ -110,29 +111,38 @@ class StudyStore:
     # -- progress ----------------------------------------------------------------------------
     def records(self) -> np.ndarray:
         """``(n_chunks, 4)`` records: finish time (epoch s, NaN if not done), runs, seconds, evaluations."""
-        return self.group["progress/chunks"][...]
+        self._records = self.group["progress/chunks"][...]
+        return self._records.copy()
 
     def done(self) -> np.ndarray:
         """Which chunks are complete."""
         return np.isfinite(self.records()[:, 0])
 
     def write(self, result: ChunkResult) -> None:
-        """Write one chunk's data, then its completion record."""
-        sl = self.plan.slices(result.index)
-        for name, arr in result.data.items():
+        """Write one chunk's data, then its completion record.
+
+        The number of runs of the chunk comes from the records as read at the start (this
+        process is the store's only writer) and kept up to date here.
+        """
+        for name in (*result.data, "progress/chunks"):
             if name not in self._arrays:
                 self._arrays[name] = self.group[name]
+        sl = self.plan.slices(result.index)
+        for name, arr in result.data.items():
             self._arrays[name][sl] = arr
-        rec = self.group["progress/chunks"]
-        runs = rec[result.index, 1]
+        if self._records is None:
+            self.records()
+        runs = self._records[result.index, 1]
         runs = 0.0 if not np.isfinite(runs) else float(runs)
-        rec[result.index, :] = np.array([time.time(), runs + 1.0, result.seconds, float(result.evaluations)])
+        row = np.array([time.time(), runs + 1.0, result.seconds, float(result.evaluations)])
+        self._arrays["progress/chunks"][result.index, :] = row
+        self._records[result.index] = row
 
     def begin_run(self, executor: str) -> int:
         """Record the start of a run in the store's history; returns its position."""
         history = json.loads(self.group.attrs.get("history", "[]"))
         history.append({"started": now_iso(), "ended": None, "executor": executor, "chunks_computed": 0})
-        self.group.attrs.update({"history": json.dumps(history), "updated": now_iso()})
+        self.group.update_attributes({"history": json.dumps(history), "updated": now_iso()})  # one metadata write
         return len(history) - 1
 
     def end_run(self, run: int, computed: int, interrupted: bool = False) -> None:
@@ -140,10 +150,12 @@ class StudyStore:
         attrs = self.group.attrs
         history = json.loads(attrs.get("history", "[]"))
         history[run].update(ended=now_iso(), chunks_computed=computed, interrupted=interrupted)
-        done = bool(self.done().all())
-        attrs.update({"history": json.dumps(history), "updated": now_iso(), "complete": int(done)})
+        records = self.records() if self._records is None else self._records
+        done = bool(np.isfinite(records[:, 0]).all())
+        new = {"history": json.dumps(history), "updated": now_iso(), "complete": int(done)}
         if done and not attrs.get("completed"):
-            attrs["completed"] = now_iso()
+            new["completed"] = now_iso()
+        self.group.update_attributes(new)  # one metadata write
 
     def open_dataset(self):
         """The results as an xarray Dataset (lazy, backed by the store)."""
@@ -187,7 +199,7 @@ def _initialise(group, study: Study, plan: ChunkPlan) -> None:
         "status_legend": json.dumps(dict(enumerate(STATUSES))),
     }
     attrs.update({k: (json.dumps(v) if isinstance(v, list) else v) for k, v in describe(study).items()})
-    group.attrs.update(attrs)
+    group.update_attributes(attrs)  # one metadata write (attrs.update writes once per key)
     for p in study.parameters:
         vals = p.values
         dtype = str if vals.dtype.kind == "U" else vals.dtype
