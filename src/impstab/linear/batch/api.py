@@ -27,7 +27,7 @@ def _single(model: Model) -> tuple:
 
 
 def critical_thrust_batch(
-    models: Sequence[Model | AffineDesign | None], *, n_scan: int = 64, chunk: int = 32, vectorized: bool = True
+    models: Sequence[Model | AffineDesign | None], *, n_scan: int = 64, chunk: int = 16, vectorized: bool = True
 ) -> BatchCriticalThrust:
     """Critical thrust of every model, as :func:`impstab.critical_thrust` gives it for one.
 

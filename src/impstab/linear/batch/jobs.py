@@ -99,15 +99,29 @@ class BatchCriticalThrust:
 class _PrimedEngine(_Engine):
     """An engine whose scan chunks were classified beforehand, in a batch with other designs."""
 
-    def __init__(self, family: ModelFamily, p_max: float, primed: dict) -> None:
+    def __init__(self, family: ModelFamily, p_max: float, job: "_Job") -> None:
         super().__init__(family, p_max)
-        self.primed = primed
+        self.job = job
 
     def classify(self, p: Array):
-        hit = self.primed.get((float(p[0]), len(p))) if len(p) else None
+        hit = self.job.primed(p)
         if hit is not None:  # counted by the job that classified it
             return hit
         return super().classify(p)
+
+
+@dataclass(eq=False)
+class _ScanTable:
+    """The batched scan of many jobs: one row per job, grid points classified so far.
+
+    ``flags (J, n_pts)`` unstable points, ``ind (J, n_pts, 2)`` the bubble indicators (NaN where
+    not classified), ``length (J,)`` points classified (whole chunks of ``chunk`` points from 0).
+    """
+
+    flags: NDArray[np.bool_]
+    ind: Array
+    length: NDArray[np.int64]
+    chunk: int
 
 
 class _Stack(_Engine):
@@ -136,9 +150,8 @@ class _Job:
     def __init__(self, family: ModelFamily, p_max: float, n_scan: int) -> None:
         self._family, self._factory, self.p_max = family, None, p_max
         self.grid = _grid(p_max, n_scan)
-        self.primed: dict = {}
-        self.flags: list = []
-        self.ind: list = []
+        self.table: _ScanTable | None = None
+        self.row = -1
         self.evaluations = 0
         self._engine: _PrimedEngine | None = None
         parts = family.affine_parts()
@@ -156,7 +169,7 @@ class _Job:
         job = cls.__new__(cls)
         job._family, job._factory, job.p_max = None, design.family, design.thrust_max
         job.grid = _grid(design.thrust_max, n_scan)
-        job.primed, job.flags, job.ind, job.evaluations, job._engine = {}, [], [], 0, None
+        job.table, job.row, job.evaluations, job._engine = None, -1, 0, None
         job.fast, job.undamped = True, True
         job.mass, job.k0, job.k1 = design.mass, design.k0, design.k1
         return job
@@ -169,8 +182,19 @@ class _Job:
 
     def engine(self) -> _PrimedEngine:
         if self._engine is None:
-            self._engine = _PrimedEngine(self.family, self.p_max, self.primed)
+            self._engine = _PrimedEngine(self.family, self.p_max, self)
         return self._engine
+
+    def primed(self, p: Array) -> tuple | None:
+        """The batched classification of the scan chunk ``p`` (the engine's), if it was made."""
+        t = self.table
+        if t is None or not len(p):
+            return None
+        start = int(np.searchsorted(self.grid, p[0]))
+        stop = min(start + t.chunk, len(self.grid))
+        if start % t.chunk or stop > t.length[self.row] or len(p) != stop - start or not np.array_equal(p, self.grid[start:stop]):
+            return None
+        return t.flags[self.row, start:stop], t.ind[self.row, start:stop]
 
     def point_op(self, x: float) -> Array:
         """The eigen-operator at one load, as the engine forms it."""

@@ -148,7 +148,7 @@ def _solve_jobs(jobs: list[_Job], chunk: int, vectorized: bool, errors: dict) ->
     """First loss of stability of every job that has not failed."""
     results: dict[int, tuple] = {}
     live = [j for j in jobs if id(j) not in errors]
-    engine_only: list = [j for j in live if not vectorized or j.flags[0][0]]
+    engine_only: list = [j for j in live if not vectorized or j.table.flags[j.row, 0]]
     scanned = [j for j in live if j not in engine_only]
     brackets = _brackets(scanned, errors) if scanned else []
     fast = [(j, br) for j, br in zip(scanned, brackets) if j.fast and br is not None and id(j) not in errors]

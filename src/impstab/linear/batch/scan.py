@@ -7,7 +7,7 @@ from numpy.typing import NDArray
 
 from ..critical import TOL_DUPLICATE, TOL_UNSTABLE
 from ..blocks import decoupled_blocks, eig_affine, eigvals_affine_blocks
-from .jobs import _Job, _Stack, gather
+from .jobs import _Job, _ScanTable, _Stack, gather
 
 Array = NDArray[np.float64]
 
@@ -30,7 +30,11 @@ def _operators(jobs: list[_Job]) -> None:
         j.a0, j.a1, j.pack, j.row = a0[i], a1[i], pack, i
 
 
-def _classify_group(jobs: list[_Job], start: int, stop: int) -> list:
+def _classify_group(jobs: list[_Job], start: int, stop: int) -> tuple | list:
+    """Flags ``(J, m)`` and indicators ``(J, m, 2)`` of the jobs' grid points ``start:stop``.
+
+    Where the stacked call fails, a list with each job's own ``(flags, ind)`` or exception.
+    """
     try:
         if jobs[0].fast:  # the operators a0 + p a1 are formed one at a time in the kernel, block by block
             a0, a1, blocks = gather(jobs)
@@ -50,30 +54,45 @@ def _classify_group(jobs: list[_Job], start: int, stop: int) -> list:
                 out.append(exc)
         return out
     n = stop - start
-    return [(flags[i * n:(i + 1) * n], ind[i * n:(i + 1) * n]) for i in range(len(jobs))]
+    return flags.reshape(len(jobs), n), ind.reshape(len(jobs), n, 2)
 
 
 def _prime(jobs: list[_Job], chunk: int, errors: dict) -> None:
-    """Classify each job's scan grid chunk by chunk, batched; a job stops where its scan would."""
+    """Classify each job's scan grid chunk by chunk, batched; a job stops where its scan would.
+
+    The classifications go to one :class:`_ScanTable` shared by the jobs (``job.table``,
+    ``job.row``), where the vectorized steps and each job's own engine find them.
+    """
     n_pts = len(jobs[0].grid) if jobs else 0
-    first = {id(j): n_pts for j in jobs}
-    active, start = list(jobs), 0
-    while active and start < n_pts:
+    table = _ScanTable(np.zeros((len(jobs), n_pts), dtype=bool), np.full((len(jobs), n_pts, 2), np.nan),
+                       np.zeros(len(jobs), dtype=np.int64), chunk)
+    for r, j in enumerate(jobs):
+        j.table, j.row = table, r
+    first = np.full(len(jobs), n_pts)
+    active, start = np.arange(len(jobs)), 0
+    while active.size and start < n_pts:
         stop = min(start + chunk, n_pts)
-        for key in {(j.fast, j.undamped) for j in active}:
-            group = [j for j in active if (j.fast, j.undamped) == key]
-            for j, r in zip(group, _classify_group(group, start, stop)):
-                if isinstance(r, Exception):
-                    errors[id(j)] = r
-                    continue
-                j.primed[(float(j.grid[start]), stop - start)] = r
-                j.flags.append(r[0])
-                j.ind.append(r[1])
-                j.evaluations += stop - start
-                bad = np.flatnonzero(r[0])
-                if bad.size and first[id(j)] == n_pts:
-                    first[id(j)] = start + int(bad[0])
-        active = [j for j in active if id(j) not in errors and first[id(j)] >= stop - 1]
+        keys = [(jobs[r].fast, jobs[r].undamped) for r in active]
+        for key in set(keys):
+            rows = active[np.array([k == key for k in keys])]
+            group = [jobs[r] for r in rows]
+            res = _classify_group(group, start, stop)
+            if isinstance(res, list):  # the stacked call failed: each job's own result
+                ok = np.array([not isinstance(x, Exception) for x in res])
+                for j, x in zip(group, res):
+                    if isinstance(x, Exception):
+                        errors[id(j)] = x
+                rows, res = rows[ok], (np.array([x[0] for x, o in zip(res, ok) if o]).reshape(-1, stop - start),
+                                       np.array([x[1] for x, o in zip(res, ok) if o]).reshape(-1, stop - start, 2))
+            table.flags[rows, start:stop], table.ind[rows, start:stop] = res
+            table.length[rows] = stop
+            for r in rows.tolist():
+                jobs[r].evaluations += stop - start
+        hit = table.flags[active, start:stop]
+        pos = np.where(hit.any(axis=1), start + np.argmax(hit, axis=1), n_pts)
+        first[active] = np.where(first[active] == n_pts, pos, first[active])
+        live = np.array([id(jobs[r]) not in errors for r in active], dtype=bool)
+        active = active[live & (first[active] >= stop - 1)]
         start = stop
 
 
@@ -85,12 +104,9 @@ def _brackets(jobs: list[_Job], errors: dict) -> list:
     affine undamped jobs and the engine's own for the others (always true when damped).
     """
     n_pts = len(jobs[0].grid)
-    flags = np.zeros((len(jobs), n_pts), dtype=bool)
-    ind = np.full((len(jobs), n_pts, 2), np.nan)
-    length = np.array([sum(len(f) for f in j.flags) for j in jobs])
-    for r, j in enumerate(jobs):
-        flags[r, : length[r]] = np.concatenate(j.flags)
-        ind[r, : length[r]] = np.concatenate(j.ind)
+    table = jobs[0].table
+    rows = np.array([j.row for j in jobs])
+    flags, ind, length = table.flags[rows], table.ind[rows], table.length[rows]
     js = np.arange(n_pts)[None, :]
     upper = np.where(length < n_pts, length - 1, n_pts)[:, None]
     valid = (js >= 1) & (js < upper)
