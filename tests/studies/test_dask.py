@@ -34,3 +34,21 @@ def test_existing_scheduler_by_address(tmp_path, capsys):
                      "--no-progress"])
     assert code == 0, capsys.readouterr().err
     assert _values(tmp_path / "remote.zarr").identical(_values(tmp_path / "local.zarr"))
+
+
+def _malloc_env():
+    import os
+
+    return os.environ.get("MALLOC_TRIM_THRESHOLD_")
+
+
+def test_local_cluster_workers_keep_adaptive_malloc(monkeypatch):
+    """Dask's nannies set MALLOC_TRIM_THRESHOLD_ (1.5x slower chunks here); ours do not."""
+    from impstab.studies.execute import local_cluster
+
+    monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
+    with local_cluster(1, dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        assert set(client.run(_malloc_env).values()) == {None}
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=logging.ERROR) as cluster, distributed.Client(cluster) as client:
+        assert set(client.run(_malloc_env).values()) == {"65536"}  # what the plain cluster does
