@@ -223,3 +223,42 @@ values = { start = 5e3, stop = 5e4, num = 9, scale = "log" }
     assert (kind[flutter] == 1).all() and (kind[~flutter] == 0).all()
     np.testing.assert_allclose(got[flutter], exact[flutter], rtol=1e-11)
     np.testing.assert_allclose(ds["margin"].values[flutter], exact[flutter] / 2000.0, rtol=1e-11)
+
+
+def test_wide_brackets_are_halved_in_the_batch_as_the_engine_does(monkeypatch):
+    """A coupled layout whose merging pair rotates over a grid interval (a third mode close by):
+    the cluster at the bracket's unstable end is not clearly one at its stable end, so the
+    bracket is halved on the classification before the exact refinement, as the engine does,
+    and no design needs its own engine."""
+    from impstab.linear.batch import refine
+
+    base = read_toml(EXAMPLES / "imp_asymmetric.toml")
+    base["analysis"]["linearization"] = "classical"
+    models = []
+    for x in np.linspace(0.20, 0.225, 4):
+        for k in np.geomspace(8.5e3, 9.8e3, 4):
+            d = copy.deepcopy(base)
+            d["mounts"][0]["position"][0] = float(x)
+            d["mounts"][0]["k_shear"] = float(k)
+            models.append(model_from_dict(d))
+    halved, engine = [0], [0]
+    once, first_loss = refine._refine_once, refine._engine_first_loss
+
+    def count_once(jobs, a, b):
+        res, retry = once(jobs, a, b)
+        halved[0] += int(np.sum(retry == refine._BISECT))
+        return res, retry
+
+    def count_engine(*args):
+        engine[0] += 1
+        return first_loss(*args)
+
+    monkeypatch.setattr(refine, "_refine_once", count_once)
+    monkeypatch.setattr(refine, "_engine_first_loss", count_engine)
+    got = critical_thrust_batch(models)
+    assert halved[0] > 0 and engine[0] == 0
+    for j, m in enumerate(models):
+        ref = impstab.critical_thrust(m)
+        assert got.status[j] == 0 and batch.KINDS[got.kind[j]] == ref.kind
+        assert _close(ref.thrust, got.thrust[j]) and _close(ref.omega, got.omega[j])
+        assert got.modes[j] == ",".join(ref.modes)

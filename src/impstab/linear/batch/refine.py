@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..blocks import eig_affine
+from ..blocks import eig_affine, eigvals_affine_blocks
 from ..critical import FLOOR, TOL_CLUSTER, TOL_DUPLICATE
 from ..eigen import cluster_participation
 from .jobs import _EPS4, _Job, _Stack, gather
@@ -27,11 +27,55 @@ def _select(vecs: Array, proj: Array, k: NDArray) -> tuple[NDArray, NDArray]:
     return rank < k[:, None], ok
 
 
+#: what a bracket needs next (``_refine_once``): done (or its own engine), bisection, step back
+_DONE, _BISECT, _STEP_BACK = 0, 1, 2
+
+
 def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
-    """The engine's ``refine`` on each bracket, vectorized; None where a job must use its engine."""
+    """The engine's ``refine`` on each bracket, vectorized; None where a job must use its engine.
+
+    As the engine does: where the cluster going unstable at ``b`` is not clearly a cluster at
+    ``a`` (a wide bracket over which the modes rotate, or a third mode nearby), the bracket is
+    halved on the stability classification and the exact refinement tried again; where the
+    exact indicator shows ``a`` already past the onset, ``a`` steps back by the bracket width.
+    """
     n = len(jobs)
     a = np.array([br[0] for br in brackets])
     b = np.array([br[1] for br in brackets])
+    p_max = np.array([j.p_max for j in jobs])
+    out: list = [None] * n
+    rows = np.arange(n)
+    for _ in range(200):  # the engine's limit
+        res, retry = _refine_once([jobs[r] for r in rows], a[rows], b[rows])
+        for i in np.flatnonzero(retry == _DONE):
+            out[rows[i]] = res[i]
+        back = rows[retry == _STEP_BACK]
+        new_a = np.clip(2 * a[back] - b[back], 0.0, p_max[back])
+        back, a[back] = back[new_a != a[back]], new_a
+        half = rows[retry == _BISECT]
+        mid = 0.5 * (a[half] + b[half])
+        keep = (mid != a[half]) & (mid != b[half])
+        half, mid = half[keep], mid[keep]
+        if half.size:
+            sub = [jobs[r] for r in half]
+            a0, a1, blocks = gather(sub)
+            unstable, _ = _Stack(None, True).classify_values(eigvals_affine_blocks(a0, a1, mid[:, None], blocks)[:, 0])
+            for j in sub:
+                j.evaluations += 1
+            b[half[unstable]], a[half[~unstable]] = mid[unstable], mid[~unstable]
+        rows = np.sort(np.concatenate([back, half]))
+        if not rows.size:
+            break
+    return out
+
+
+def _refine_once(jobs: list[_Job], a: Array, b: Array) -> tuple[list, NDArray[np.int8]]:
+    """One attempt of the exact refinement of each bracket ``(a, b)``, vectorized.
+
+    Returns each result (None where there is none) and what the bracket needs next: ``_DONE``
+    (a result, or None for the job's own engine), ``_BISECT`` or ``_STEP_BACK``.
+    """
+    n = len(jobs)
     a0, a1, blocks = gather(jobs)
 
     def eig(p, rows):
@@ -54,7 +98,11 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
     proj = (vecs_b * members[:, None, :]) @ inv_b
     vals_a, vecs_a, _, fine_a = eig(a, None)
     _, ok_a = _select(vecs_a, proj, k)
-    good &= bad.any(-1) & ~(bad & ~members).any(-1) & ok_a & fine_a
+    good &= bad.any(-1) & fine_a
+    # the engine's "unique and ok_a": every unstable eigenvalue in the cluster, found again at a
+    clear = ~(bad & ~members).any(-1) & ok_a
+    retry = np.where(good & ~clear, _BISECT, _DONE).astype(np.int8)
+    good &= clear
 
     def indicator(vals, vecs, inv, fine, rows, derivative):
         sel, ok = _select(vecs, proj[rows], k[rows])
@@ -71,6 +119,8 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
 
     fa, oka = indicator(vals_a, vecs_a, None, fine_a, slice(None), False)
     fb, okb = indicator(vals_b, vecs_b, inv_b, good, slice(None), False)
+    retry[good & ~(oka & okb)] = _BISECT  # the engine's _Ambiguous
+    retry[good & oka & okb & (fa != 0) & (np.sign(fa) == np.sign(fb))] = _STEP_BACK  # _NoSignChange
     good &= oka & okb & ((fa == 0) | (np.sign(fa) != np.sign(fb)))
     root = np.where(fa == 0, a, np.nan)
     live = np.flatnonzero(good & (fa != 0))
@@ -84,6 +134,7 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
         evals[live] += 1
         f, df, ok = indicator(vals, vecs, inv, fine, live, True)
         good[live[~ok]] = False
+        retry[live[~ok]] = _BISECT
         done = ok & (f == 0)
         root[live[done]] = p[live[done]]
         same = np.sign(f) == np.sign(flo[live])
@@ -98,13 +149,14 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
         root[live[conv]] = new[conv]
         p[live] = new
         live = live[ok & ~done & ~conv]
+    retry[live] = _BISECT  # no convergence in 100 steps: the engine's _Ambiguous
     good &= np.isfinite(root)
     rows = np.flatnonzero(good)
     out: list = [None] * n
     for j, e in zip(jobs, evals + good):
         j.evaluations += int(e)
     if not rows.size:
-        return out
+        return out, retry
     vals, vecs, _, _ = eig(root[rows], rows)
     sel, _ = _select(vecs, proj[rows], k[rows])
     sel_a, ok_sa = _select(vecs_a[rows], proj[rows], k[rows])
@@ -117,7 +169,7 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
         div = bool(divergence[r])
         omega = 0.0 if div else float(np.sqrt(max(mean[i], 0.0)))
         out[r] = (float(root[r]), "divergence" if div else "flutter", omega, part[i])
-    return out
+    return out, retry
 
 
 # -- per-design engine path and the driver ----------------------------------------------------
