@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import impstab
-from impstab.linear.blocks import TOL_DECOUPLE, decoupled_blocks, eig_affine, eigvals_affine_blocks
+from impstab.linear.blocks import TOL_DECOUPLE, _eig_blocks, decoupled_blocks, eig_affine, eigvals_affine_blocks
 from impstab.linear.linearize import ModelFamily
 from impstab.linear.small_eig import eigvals_affine
 from test_small_eig import _match  # greedy matching of two eigenvalue multisets
@@ -172,3 +172,58 @@ def test_asymmetric_propulsor_stays_coupled():
     m, _, _, k0, k1 = fam.affine_parts()
     bs = decoupled_blocks(np.linalg.solve(m, k0)[None], np.linalg.solve(m, k1)[None], np.array([1e4]))
     assert bs.largest[0] >= 3
+
+
+def test_defective_larger_block_falls_back_without_raising():
+    """A 3 x 3 Jordan block: inverse iteration finds one vector three times, the eigenvector
+    matrix is singular, and LAPACK's route takes over (which reports it or returns a huge
+    inverse); nothing raises, and a regular design in the same batch is solved."""
+    a0 = np.zeros((2, 5, 5))
+    a0[0, :3, :3] = [[2.0, 1.0, 0.0], [0.0, 2.0, 1.0], [0.0, 0.0, 2.0]]
+    a0[0, 3, 3], a0[0, 4, 4] = 5.0, 7.0
+    rng = np.random.default_rng(9)
+    a0[1] = rng.standard_normal((5, 5)) + 5 * np.eye(5)
+    a1 = np.zeros_like(a0)
+    bs = decoupled_blocks(a0, a1, np.ones(2))
+    assert bs.largest[0] == 3 and bs.largest[1] == 5
+    vals, vecs, inv, ok = eig_affine(a0, a1, np.zeros(2), bs)
+    assert (not ok[0]) or np.abs(inv[0]).max() > 1e4
+    assert ok[1] and np.abs(a0[1] @ vecs[1] - vecs[1] * vals[1]).max() < 1e-12 * np.abs(a0[1]).max() * np.linalg.cond(vecs[1])
+    # a nilpotent block: zero pivots in every shifted factorisation, no division by zero
+    z = np.zeros((1, 3, 3))
+    z[0, 0, 1] = z[0, 1, 2] = 1.0
+    bs = decoupled_blocks(z, np.zeros_like(z), np.ones(1))
+    assert bs.largest[0] == 3
+    vals, vecs, inv, ok = eig_affine(z, np.zeros_like(z), np.zeros(1), bs)
+    assert np.abs(vals).max() < 1e-5 and ((not ok[0]) or np.abs(inv[0]).max() > 1e4)
+
+
+def test_coupled_blocks_match_lapack_on_the_asymmetric_propulsor():
+    """The compiled route for a coupled 6 x 6 (QR + inverse iteration) against LAPACK's eig."""
+    from impstab.model import model_from_dict
+    from impstab.model.assemble import read_toml
+
+    d = read_toml("examples/imp_asymmetric.toml")
+    d["analysis"]["linearization"] = "classical"
+    m, _, _, k0, k1 = ModelFamily(model_from_dict(d)).affine_parts()
+    loads = np.linspace(0.0, 6e4, 301)  # stable, near the flutter onset, and far past it
+    a0 = np.repeat(np.linalg.solve(m, k0)[None], len(loads), 0)
+    a1 = np.repeat(np.linalg.solve(m, k1)[None], len(loads), 0)
+    bs = decoupled_blocks(a0, a1, np.full(len(loads), 6e4))
+    assert (bs.largest == 6).all()
+    # the compiled route itself (eig_affine would hide its failures behind LAPACK)
+    vals, vecs, inv = np.empty((len(loads), 6), complex), np.empty((len(loads), 6, 6), complex), np.empty((len(loads), 6, 6), complex)
+    ok = np.zeros(len(loads), dtype=bool)
+    _eig_blocks(a0, a1, loads, bs.order, bs.starts, bs.nblocks, vals, vecs, inv, ok)
+    ref_vals, ref_vecs, ref_inv, ref_ok = eig_affine(a0, a1, loads, None)
+    assert ok.all() and ref_ok.all()
+    for s in range(len(loads)):
+        a = a0[s] + loads[s] * a1[s]
+        cond = np.linalg.cond(vecs[s])
+        assert np.abs(a @ vecs[s] - vecs[s] * vals[s]).max() <= 400 * EPS * np.abs(a).sum(axis=1).max()
+        assert np.abs(inv[s] @ vecs[s] - np.eye(6)).max() <= 100 * EPS * cond
+        # each unit eigenvector equals LAPACK's up to a phase (simple eigenvalues here)
+        for k in range(6):
+            j = int(np.argmin(np.abs(ref_vals[s] - vals[s, k])))
+            overlap = abs(np.vdot(ref_vecs[s][:, j], vecs[s][:, k]))
+            assert abs(overlap - 1) <= 1e3 * EPS * cond

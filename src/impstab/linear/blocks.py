@@ -38,7 +38,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from .small_eig import _balance, _solve_one, eigvals_affine
+from .small_eig import MAX_ORDER, _balance, _solve_one, eigvals_affine
 
 __all__ = ["BlockStructure", "TOL_DECOUPLE", "decoupled_blocks", "eigvals_affine_blocks", "eig_affine"]
 
@@ -241,49 +241,218 @@ def eigvals_affine_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], load
 
 
 @njit(cache=True)
+def _lu(b, m, piv, tiny):
+    """LU factorisation with partial pivoting of the complex ``b[:m, :m]`` in place.
+
+    A zero pivot becomes ``tiny`` (inverse iteration: the shifted matrix is singular to working
+    precision by design); returns whether that happened (with ``tiny`` 0 the factorisation
+    stops there: singular).
+    """
+    hit = False
+    for k in range(m):
+        p = k
+        big = abs(b[k, k].real) + abs(b[k, k].imag)  # LAPACK's cabs1: as good a pivot, no hypot
+        for i in range(k + 1, m):
+            size = abs(b[i, k].real) + abs(b[i, k].imag)
+            if size > big:
+                big = size
+                p = i
+        piv[k] = p
+        if p != k:
+            for j in range(m):
+                t = b[k, j]
+                b[k, j] = b[p, j]
+                b[p, j] = t
+        if b[k, k] == 0.0:
+            hit = True
+            if tiny == 0.0:  # singular, and no substitute wanted
+                return hit
+            b[k, k] = tiny
+        rec = 1.0 / b[k, k]
+        for i in range(k + 1, m):
+            f = b[i, k] * rec
+            b[i, k] = f
+            for j in range(k + 1, m):
+                b[i, j] -= f * b[k, j]
+    return hit
+
+
+@njit(cache=True)
+def _lu_solve(b, m, piv, x):
+    """Solve ``B y = x`` in place with the factors of :func:`_lu`."""
+    for k in range(m):
+        p = piv[k]
+        if p != k:
+            t = x[k]
+            x[k] = x[p]
+            x[p] = t
+    for i in range(m):
+        for j in range(i):
+            x[i] -= b[i, j] * x[j]
+    for i in range(m - 1, -1, -1):
+        for j in range(i + 1, m):
+            x[i] -= b[i, j] * x[j]
+        x[i] /= b[i, i]
+
+
+@njit(cache=True)
+def _eigvector(w0, m, lam, norm, b, piv, x):
+    """Unit eigenvector of ``w0[:m, :m]`` for the computed eigenvalue ``lam``, by inverse iteration.
+
+    Steps of ``(A - lam I) x_new = x`` from a fixed start with unequal entries until the residual
+    ``|A x - lam x|`` is below ``64 m eps |A|`` (``norm``: the infinity norm of ``A``): then ``x``
+    is an exact eigenvector of a matrix within that distance of ``A``, the backward stability
+    LAPACK's vectors have. The shift is accurate to ``eps |A|``, so one step is usually enough;
+    False after three (then LAPACK takes over).
+    """
+    for i in range(m):
+        for j in range(m):
+            b[i, j] = w0[i, j]
+        b[i, i] -= lam
+    _lu(b, m, piv, max(_EPS * norm, 1e-300))
+    for i in range(m):
+        x[i] = 1.0 + 0.1 * sqrt(i + 2.0)
+    for _ in range(3):
+        _lu_solve(b, m, piv, x)
+        size = 0.0
+        for i in range(m):
+            size += x[i].real ** 2 + x[i].imag ** 2
+        if not (size > 0.0 and np.isfinite(size)):
+            return False
+        size = 1.0 / sqrt(size)
+        for i in range(m):
+            x[i] *= size
+        worst = 0.0
+        for i in range(m):
+            r = -lam * x[i]
+            for j in range(m):
+                r += w0[i, j] * x[j]
+            worst = max(worst, abs(r.real) + abs(r.imag))
+        if worst <= 64.0 * m * _EPS * norm:
+            return True
+    return False
+
+
+@njit(cache=True)
+def _eig_block(w, w0, m, v, wr, wi, vals, vecs, inv, b, piv, x, b_real, x_real):
+    """Eigenvalues (compiled QR), unit eigenvectors and their inverse of the block ``w0[:m, :m]``.
+
+    ``w`` holds a copy (destroyed). Results go to ``vals[:m]``, ``vecs[:m, :m]``, ``inv[:m, :m]``;
+    False if any step fails. A real eigenvalue's vector is found in real arithmetic (``b_real``,
+    ``x_real``: the same routines, compiled for real arrays), a complex pair's once.
+    """
+    if not _solve_one(w, m, v, wr, wi, vals):
+        return False
+    norm = 0.0
+    for i in range(m):
+        row = 0.0
+        for j in range(m):
+            row += abs(w0[i, j])
+        norm = max(norm, row)
+    t = 0
+    while t < m:
+        if vals[t].imag == 0.0:
+            if not _eigvector(w0, m, vals[t].real, norm, b_real, piv, x_real):
+                return False
+            for i in range(m):
+                vecs[i, t] = x_real[i]
+            t += 1
+            continue
+        if not _eigvector(w0, m, vals[t], norm, b, piv, x):
+            return False
+        for i in range(m):
+            vecs[i, t] = x[i]
+        if vals[t].imag > 0.0 and t + 1 < m and vals[t + 1] == vals[t].conjugate():
+            for i in range(m):  # the conjugate pair's vector, exactly conjugate
+                vecs[i, t + 1] = x[i].conjugate()
+            t += 2
+        else:
+            t += 1
+    # inverse of the eigenvectors: LU, then the columns of the identity
+    for i in range(m):
+        for j in range(m):
+            b[i, j] = vecs[i, j]
+    if _lu(b, m, piv, 0.0):
+        return False
+    for c in range(m):
+        for i in range(m):
+            x[i] = 1.0 if i == c else 0.0
+        _lu_solve(b, m, piv, x)
+        for i in range(m):
+            if not (np.isfinite(x[i].real) and np.isfinite(x[i].imag)):
+                return False
+            inv[i, c] = x[i]
+    return True
+
+
+@njit(cache=True)
 def _eig_blocks(a0, a1, loads, order, starts, nblocks, vals, vecs, inv, ok):
-    """Eigen-decomposition of designs whose blocks have at most two dofs."""
+    """Eigen-decomposition of each design, block by block (closed forms up to two dofs)."""
     count, n = a0.shape[0], a0.shape[1]
+    w = np.empty((n, n))
+    w0 = np.empty((n, n))
+    v, wr, wi = np.empty(n), np.empty(n), np.empty(n)
+    bv = np.empty(n, dtype=np.complex128)
+    bvec = np.empty((n, n), dtype=np.complex128)
+    binv = np.empty((n, n), dtype=np.complex128)
+    lu = np.empty((n, n), dtype=np.complex128)
+    piv = np.empty(n, dtype=np.int64)
+    x = np.empty(n, dtype=np.complex128)
+    lu_real = np.empty((n, n))
+    x_real = np.empty(n)
     for s in range(count):
         p = loads[s]
         good = True
-        for x in range(n):
-            for y in range(n):
-                vecs[s, x, y] = 0.0
-                inv[s, x, y] = 0.0
+        for r in range(n):
+            for c in range(n):
+                vecs[s, r, c] = 0.0
+                inv[s, r, c] = 0.0
         for b in range(nblocks[s]):
             lo, hi = starts[s, b], starts[s, b + 1]
-            if hi - lo == 1:
+            m = hi - lo
+            if m == 1:
                 r = order[s, lo]
                 vals[s, lo] = complex(a0[s, r, r] + p * a1[s, r, r], 0.0)
                 vecs[s, r, lo] = 1.0
                 inv[s, lo, r] = 1.0
                 continue
-            if hi - lo != 2:
+            if m == 2:
+                i, j = order[s, lo], order[s, lo + 1]
+                a = a0[s, i, i] + p * a1[s, i, i]
+                bb = a0[s, i, j] + p * a1[s, i, j]
+                c = a0[s, j, i] + p * a1[s, j, i]
+                d = a0[s, j, j] + p * a1[s, j, j]
+                l1, l2 = _values2(a, bb, c, d)
+                v00, v10 = _vector2(l1, a, bb, c, d, True)
+                v01, v11 = _vector2(l2, a, bb, c, d, False)
+                det = v00 * v11 - v01 * v10
+                if det == 0.0 or not (np.isfinite(det.real) and np.isfinite(det.imag)):
+                    good = False
+                    continue
+                vals[s, lo] = l1
+                vals[s, lo + 1] = l2
+                vecs[s, i, lo] = v00
+                vecs[s, j, lo] = v10
+                vecs[s, i, lo + 1] = v01
+                vecs[s, j, lo + 1] = v11
+                inv[s, lo, i] = v11 / det
+                inv[s, lo, j] = -v01 / det
+                inv[s, lo + 1, i] = -v10 / det
+                inv[s, lo + 1, j] = v00 / det
+                continue
+            for xx in range(m):
+                for yy in range(m):
+                    i, j = order[s, lo + xx], order[s, lo + yy]
+                    w0[xx, yy] = a0[s, i, j] + p * a1[s, i, j]
+                    w[xx, yy] = w0[xx, yy]
+            if not _eig_block(w, w0, m, v, wr, wi, bv, bvec, binv, lu, piv, x, lu_real, x_real):
                 good = False
                 continue
-            i, j = order[s, lo], order[s, lo + 1]
-            a = a0[s, i, i] + p * a1[s, i, i]
-            bb = a0[s, i, j] + p * a1[s, i, j]
-            c = a0[s, j, i] + p * a1[s, j, i]
-            d = a0[s, j, j] + p * a1[s, j, j]
-            l1, l2 = _values2(a, bb, c, d)
-            v00, v10 = _vector2(l1, a, bb, c, d, True)
-            v01, v11 = _vector2(l2, a, bb, c, d, False)
-            det = v00 * v11 - v01 * v10
-            if det == 0.0 or not (np.isfinite(det.real) and np.isfinite(det.imag)):
-                good = False
-                continue
-            vals[s, lo] = l1
-            vals[s, lo + 1] = l2
-            vecs[s, i, lo] = v00
-            vecs[s, j, lo] = v10
-            vecs[s, i, lo + 1] = v01
-            vecs[s, j, lo + 1] = v11
-            inv[s, lo, i] = v11 / det
-            inv[s, lo, j] = -v01 / det
-            inv[s, lo + 1, i] = -v10 / det
-            inv[s, lo + 1, j] = v00 / det
+            for xx in range(m):
+                vals[s, lo + xx] = bv[xx]
+                for yy in range(m):
+                    vecs[s, order[s, lo + xx], lo + yy] = bvec[xx, yy]
+                    inv[s, lo + xx, order[s, lo + yy]] = binv[xx, yy]
         ok[s] = good
 
 
@@ -318,8 +487,10 @@ def eig_affine(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[
     a0, a1 : (N, n, n) float arrays
     loads : (N,) float array
     blocks : BlockStructure, optional
-        Designs whose blocks have at most two dofs are solved in closed form; the others (and
-        all designs without a structure) by ``np.linalg.eig`` on the whole operator.
+        Each block is solved on its own: in closed form up to two dofs, else by the compiled
+        QR (:mod:`impstab.linear.small_eig`) and inverse iteration. A design whose blocks fail
+        (a residual above ``64 m eps |A|``, singular eigenvectors), and every design without a
+        structure, goes to ``np.linalg.eig`` on the whole operator.
 
     Returns
     -------
@@ -336,7 +507,7 @@ def eig_affine(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[
     a1 = np.ascontiguousarray(a1, dtype=float)
     loads = np.ascontiguousarray(loads, dtype=float)
     count, n = a0.shape[0], a0.shape[-1]
-    small = np.zeros(count, dtype=bool) if blocks is None else blocks.largest <= 2
+    small = np.zeros(count, dtype=bool) if blocks is None else blocks.largest <= MAX_ORDER
     vals = np.empty((count, n), dtype=np.complex128)
     vecs = np.empty((count, n, n), dtype=np.complex128)
     inv = np.empty((count, n, n), dtype=np.complex128)
