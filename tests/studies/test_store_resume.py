@@ -231,3 +231,40 @@ def test_run_leaves_the_garbage_collector_as_it_found_it(tmp_path):
         assert gc.get_freeze_count() > frozen // 2  # still frozen (some frozen objects died meanwhile)
     finally:
         gc.unfreeze()
+
+
+def test_chunk_pauses_the_collector_and_restores_it(tmp_path, monkeypatch):
+    """evaluate_chunk runs with the cyclic collector off and leaves it as it found it, also
+    when the chunk fails."""
+    import gc
+
+    from impstab.studies import evaluate
+    from impstab.studies.execute import chunk_task
+
+    study = load_study(write_study(tmp_path, GRID_6x5))
+    task = chunk_task(study, plan_chunks(study), 0)
+    seen = []
+    real = evaluate._evaluate
+
+    def spy(t):
+        seen.append(gc.isenabled())
+        return real(t)
+
+    monkeypatch.setattr(evaluate, "_evaluate", spy)
+    assert gc.isenabled()
+    evaluate.evaluate_chunk(task)
+    assert seen == [False] and gc.isenabled()
+    gc.disable()
+    try:
+        evaluate.evaluate_chunk(task)
+        assert not gc.isenabled()  # left off, as the caller had it
+    finally:
+        gc.enable()
+
+    def boom(t):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(evaluate, "_evaluate", boom)
+    with pytest.raises(RuntimeError):
+        evaluate.evaluate_chunk(task)
+    assert gc.isenabled()

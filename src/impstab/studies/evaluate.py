@@ -9,6 +9,7 @@ analysis fails, gets a status and a message and the others go on.
 
 from __future__ import annotations
 
+import gc
 import time
 from dataclasses import dataclass, field
 
@@ -73,6 +74,11 @@ class ChunkResult:
 def evaluate_chunk(task: ChunkTask) -> ChunkResult:
     """Critical thrust (and the other outputs) of every design in the chunk.
 
+    The cyclic garbage collector is paused while the chunk is computed: a chunk makes some
+    10^4 short-lived objects (freed by reference counting as usual), which would otherwise set
+    off full collections over every object of the process -- on a Dask worker a quarter of the
+    chunk's time. It is switched back on (if it was on) when the chunk ends or fails.
+
     Parameters
     ----------
     task : ChunkTask
@@ -82,6 +88,17 @@ def evaluate_chunk(task: ChunkTask) -> ChunkResult:
     ChunkResult
         Arrays of shape ``task.block``; ``status`` codes index :data:`impstab.linear.batch.STATUSES`.
     """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _evaluate(task)
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _evaluate(task: ChunkTask) -> ChunkResult:
+    """The body of :func:`evaluate_chunk`."""
     t0 = time.perf_counter()
     n = len(task.columns[0]) if task.columns else 1
     bulk = assemble_bulk(task.base_model, task.segments, task.columns, task.model_name)
