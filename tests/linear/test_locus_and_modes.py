@@ -72,3 +72,25 @@ def test_callable_system_in_the_generic_engine():
     assert res.load == pytest.approx(3.5 - np.sqrt(2), rel=1e-13)
     with pytest.raises(ValueError):
         impstab.critical_load(lambda p: (m, None, None, k0), k0, k1, p_max=5.0)
+
+
+@pytest.mark.parametrize("thrust", [0.0, 5000.0, 15000.0])
+def test_repeated_modes_are_the_planes_of_a_symmetric_layout(thrust):
+    """A symmetric layout's equal frequencies come as the sway-yaw and heave-pitch plane modes,
+    whatever basis the eigensolver returned; each plane mode's shape is the eigenvector of the
+    planar 2 x 2 problem (an independent route)."""
+    model = impstab.load_model("examples/imp_symmetric.toml")
+    res = modes(model, thrust)
+    sys = linearize(model, thrust)
+    a = np.linalg.solve(sys.M, sys.K)
+    for plane, (t, r), other in (("sway-yaw", (1, 5), (2, 4)), ("heave-pitch", (2, 4), (1, 5))):
+        s, v = np.linalg.eig(a[np.ix_([t, r], [t, r])])
+        for k in range(2):
+            omega = np.sqrt(s[k].real)
+            j = [i for i in range(6) if abs(res.eigenvalues[i].imag - omega) <= 1e-9 * omega
+                 and np.abs(res.shapes[list(other), i]).max() <= 1e-12]
+            assert len(j) == 1, (plane, k, res.shapes)
+            shape = res.shapes[:, j[0]]
+            assert np.abs(shape[[0, 3]]).max() <= 1e-12
+            ratio = shape[t] / shape[r]
+            assert abs(ratio - v[0, k] / v[1, k]) <= 1e-10 * max(1.0, abs(ratio))

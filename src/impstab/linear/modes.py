@@ -120,6 +120,44 @@ def _undamped_eigenpairs(system: LinearSystem):
     return lam, x
 
 
+#: relative distance within which eigenvalues are one repeated eigenvalue (as the engine's)
+TOL_REPEATED = 1e-9
+
+
+def _canonical_repeated(vals: NDArray, vecs: NDArray, m_diag: NDArray) -> NDArray:
+    """A basis of each repeated eigenvalue's eigenspace that does not depend on the eigensolver.
+
+    Any basis of the eigenspace of a repeated eigenvalue is as good as another, and LAPACK
+    returns an arbitrary one: on a symmetric layout it mixes the sway-yaw and heave-pitch
+    planes. Here ``g`` pivot dofs are chosen by QR with column pivoting of the mass-weighted
+    vectors, and the basis is the one whose vectors are 1 at their own pivot and 0 at the
+    others: on a symmetric layout exactly the two planes' modes. An exactly defective group
+    (dependent vectors) is left as it is.
+    """
+    from scipy.linalg import qr
+
+    scale = max(float(np.abs(vals).max(initial=0.0)), 1e-300)
+    out = vecs.copy()
+    start = 0
+    while start < len(vals):
+        stop = start + 1
+        while stop < len(vals) and abs(vals[stop] - vals[start]) <= TOL_REPEATED * scale:
+            stop += 1
+        if stop - start > 1:
+            v = vecs[:, start:stop]
+            _, _, piv = qr((v * np.sqrt(m_diag)[:, None]).T, pivoting=True)
+            piv = np.sort(piv[: stop - start])
+            block = v[piv, :]
+            if np.linalg.cond(block) < 1e8:
+                basis = v @ np.linalg.inv(block)
+                # listed by their first dof (sway before heave), for a stable order
+                w = np.abs(basis) * np.sqrt(m_diag)[:, None]
+                first = np.argmax(w > 1e-8 * w.max(axis=0, keepdims=True), axis=0)
+                out[:, start:stop] = basis[:, np.argsort(first, kind="stable")]
+        start = stop
+    return out
+
+
 def modes_of_system(system: LinearSystem) -> ModalResult:
     """Modes of a :class:`LinearSystem`."""
     if not (np.any(system.D) or np.any(system.G)):
@@ -132,6 +170,7 @@ def modes_of_system(system: LinearSystem) -> ModalResult:
     vals, vecs = np.asarray(vals, dtype=complex), np.asarray(vecs, dtype=complex)
     order = np.lexsort((vals.real, np.abs(vals.imag)))
     vals, vecs = vals[order], vecs[:, order]
+    vecs = _canonical_repeated(vals, vecs, np.diag(system.M))
     big = np.argmax(np.abs(vecs), axis=0)
     piv = vecs[big, np.arange(vecs.shape[1])]
     shapes = vecs / piv
