@@ -262,3 +262,19 @@ def test_wide_brackets_are_halved_in_the_batch_as_the_engine_does(monkeypatch):
         assert got.status[j] == 0 and batch.KINDS[got.kind[j]] == ref.kind
         assert _close(ref.thrust, got.thrust[j]) and _close(ref.omega, got.omega[j])
         assert got.modes[j] == ",".join(ref.modes)
+
+
+def test_mixed_batch_of_damped_and_affine_designs():
+    """Designs whose jobs are not all affine (a damped, spinning model before a symmetric one):
+    each affine job finds its own operators, whatever its place among the batch's jobs."""
+    damped = impstab.load_model(EXAMPLES / "imp_damped.toml")
+    sym = impstab.load_model(EXAMPLES / "imp_symmetric.toml")
+    d = read_toml(EXAMPLES / "imp_symmetric.toml")
+    d["mount_rings"][0]["x"] = 0.12
+    other = model_from_dict(d)
+    models = [damped, sym, damped, other, sym]
+    got = critical_thrust_batch(models)
+    for j, m in enumerate(models):
+        ref = impstab.critical_thrust(m)
+        assert got.status[j] == 0, got.message[j]
+        assert _close(ref.thrust, got.thrust[j]) and _close(ref.undamped_thrust, got.undamped_thrust[j])

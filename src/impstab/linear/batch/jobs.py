@@ -9,7 +9,6 @@ from typing import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from ..blocks import decoupled_blocks
 from ..critical import _Engine
 from ..linearize import ModelFamily
 
@@ -151,7 +150,9 @@ class _Job:
         self._family, self._factory, self.p_max = family, None, p_max
         self.grid = _grid(p_max, n_scan)
         self.table: _ScanTable | None = None
-        self.row = -1
+        self.row = -1  # in the scan table
+        self.pack: tuple | None = None  # (a0, a1, BlockStructure) of the batch's affine jobs
+        self.pack_row = -1
         self.evaluations = 0
         self._engine: _PrimedEngine | None = None
         parts = family.affine_parts()
@@ -169,7 +170,7 @@ class _Job:
         job = cls.__new__(cls)
         job._family, job._factory, job.p_max = None, design.family, design.thrust_max
         job.grid = _grid(design.thrust_max, n_scan)
-        job.table, job.row, job.evaluations, job._engine = None, -1, 0, None
+        job.table, job.row, job.pack, job.pack_row, job.evaluations, job._engine = None, -1, None, -1, 0, None
         job.fast, job.undamped = True, True
         job.mass, job.k0, job.k1 = design.mass, design.k0, design.k1
         return job
@@ -204,13 +205,11 @@ class _Job:
 
 
 def gather(jobs: list[_Job]) -> tuple:
-    """``a0, a1`` stacks and block structure of affine jobs (rows of their shared pack)."""
+    """``a0, a1`` stacks and block structure of affine jobs: rows of the pack they share.
+
+    The pack is formed for all affine jobs of a batch at once (``scan._operators``);
+    ``job.pack_row`` is a job's row in it (not its row in the scan table, ``job.row``).
+    """
     pack = jobs[0].pack
-    if all(j.pack is pack for j in jobs):
-        rows = np.array([j.row for j in jobs])
-        return pack[0][rows], pack[1][rows], pack[2].take(rows)
-    a0, a1 = np.stack([j.a0 for j in jobs]), np.stack([j.a1 for j in jobs])
-    return a0, a1, decoupled_blocks(a0, a1, np.array([j.p_max for j in jobs]))
-
-
-
+    rows = np.array([j.pack_row for j in jobs])
+    return pack[0][rows], pack[1][rows], pack[2].take(rows)

@@ -27,7 +27,7 @@ def _operators(jobs: list[_Job]) -> None:
     a0, a1 = a[: len(fast)], a[len(fast):]
     pack = (a0, a1, decoupled_blocks(a0, a1, np.array([j.p_max for j in fast])))
     for i, j in enumerate(fast):
-        j.a0, j.a1, j.pack, j.row = a0[i], a1[i], pack, i
+        j.a0, j.a1, j.pack, j.pack_row = a0[i], a1[i], pack, i
 
 
 def _classify_group(jobs: list[_Job], start: int, stop: int) -> tuple | list:
