@@ -193,6 +193,15 @@ def _vector2(lam, a, b, c, d, first):
 
 
 @njit(cache=True)
+def _fill_block(a0, a1, s, p, order, lo, m, w):
+    """``w[:m, :m]`` = the block of dofs ``order[s, lo:lo + m]`` of ``a0[s] + p a1[s]``."""
+    for x in range(m):
+        for y in range(m):
+            i, j = order[s, lo + x], order[s, lo + y]
+            w[x, y] = a0[s, i, j] + p * a1[s, i, j]
+
+
+@njit(cache=True)
 def _eigvals_blocks(a0, a1, loads, order, starts, nblocks, out, ok):
     count, n = a0.shape[0], a0.shape[1]
     w = np.empty((n, n))
@@ -204,20 +213,14 @@ def _eigvals_blocks(a0, a1, loads, order, starts, nblocks, out, ok):
             for b in range(nblocks[s]):
                 lo, hi = starts[s, b], starts[s, b + 1]
                 m = hi - lo
+                _fill_block(a0, a1, s, p, order, lo, m, w)
                 if m == 1:
-                    r = order[s, lo]
-                    out[s, k, lo] = complex(a0[s, r, r] + p * a1[s, r, r], 0.0)
+                    out[s, k, lo] = complex(w[0, 0], 0.0)
                 elif m == 2:
-                    i, j = order[s, lo], order[s, lo + 1]
-                    l1, l2 = _values2(a0[s, i, i] + p * a1[s, i, i], a0[s, i, j] + p * a1[s, i, j],
-                                      a0[s, j, i] + p * a1[s, j, i], a0[s, j, j] + p * a1[s, j, j])
+                    l1, l2 = _values2(w[0, 0], w[0, 1], w[1, 0], w[1, 1])
                     out[s, k, lo] = l1
                     out[s, k, lo + 1] = l2
                 else:
-                    for x in range(m):
-                        for y in range(m):
-                            i, j = order[s, lo + x], order[s, lo + y]
-                            w[x, y] = a0[s, i, j] + p * a1[s, i, j]
                     good = _solve_one(w, m, v, wr, wi, out[s, k, lo:hi]) and good
             for i in range(n):
                 good = good and np.isfinite(out[s, k, i].real) and np.isfinite(out[s, k, i].imag)
@@ -268,18 +271,16 @@ def _eig_blocks(a0, a1, loads, order, starts, nblocks, vals, vecs, inv, ok):
         for b in range(nblocks[s]):
             lo, hi = starts[s, b], starts[s, b + 1]
             m = hi - lo
+            _fill_block(a0, a1, s, p, order, lo, m, w0)
             if m == 1:
                 r = order[s, lo]
-                vals[s, lo] = complex(a0[s, r, r] + p * a1[s, r, r], 0.0)
+                vals[s, lo] = complex(w0[0, 0], 0.0)
                 vecs[s, r, lo] = 1.0
                 inv[s, lo, r] = 1.0
                 continue
             if m == 2:
                 i, j = order[s, lo], order[s, lo + 1]
-                a = a0[s, i, i] + p * a1[s, i, i]
-                bb = a0[s, i, j] + p * a1[s, i, j]
-                c = a0[s, j, i] + p * a1[s, j, i]
-                d = a0[s, j, j] + p * a1[s, j, j]
+                a, bb, c, d = w0[0, 0], w0[0, 1], w0[1, 0], w0[1, 1]
                 l1, l2 = _values2(a, bb, c, d)
                 v00, v10 = _vector2(l1, a, bb, c, d, True)
                 v01, v11 = _vector2(l2, a, bb, c, d, False)
@@ -298,11 +299,7 @@ def _eig_blocks(a0, a1, loads, order, starts, nblocks, vals, vecs, inv, ok):
                 inv[s, lo + 1, i] = -v10 / det
                 inv[s, lo + 1, j] = v00 / det
                 continue
-            for xx in range(m):
-                for yy in range(m):
-                    i, j = order[s, lo + xx], order[s, lo + yy]
-                    w0[xx, yy] = a0[s, i, j] + p * a1[s, i, j]
-                    w[xx, yy] = w0[xx, yy]
+            w[:m, :m] = w0[:m, :m]
             if not _eig_block(w, w0, m, v, wr, wi, bv, bvec, binv, lu, piv, x, lu_real, x_real):
                 good = False
                 continue
@@ -365,20 +362,21 @@ def eig_affine(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[
     a1 = np.ascontiguousarray(a1, dtype=float)
     loads = np.ascontiguousarray(loads, dtype=float)
     count, n = a0.shape[0], a0.shape[-1]
-    small = np.zeros(count, dtype=bool) if blocks is None else blocks.largest <= MAX_ORDER
+    compiled = np.zeros(count, dtype=bool) if blocks is None else blocks.largest <= MAX_ORDER
     vals = np.empty((count, n), dtype=np.complex128)
     vecs = np.empty((count, n, n), dtype=np.complex128)
     inv = np.empty((count, n, n), dtype=np.complex128)
     ok = np.zeros(count, dtype=np.bool_)
-    if small.any():
-        rows = np.flatnonzero(small)
+    if blocks is not None and compiled.all():  # the usual case: no copies
+        _eig_blocks(a0, a1, loads, blocks.order, blocks.starts, blocks.nblocks, vals, vecs, inv, ok)
+    elif compiled.any():
+        rows = np.flatnonzero(compiled)
         sub = blocks.take(rows)
         v, w, u, good = (np.empty((len(rows), n), np.complex128), np.empty((len(rows), n, n), np.complex128),
                          np.empty((len(rows), n, n), np.complex128), np.zeros(len(rows), np.bool_))
         _eig_blocks(a0[rows], a1[rows], loads[rows], sub.order, sub.starts, sub.nblocks, v, w, u, good)
         vals[rows], vecs[rows], inv[rows], ok[rows] = v, w, u, good
-        small[rows[~good]] = False
-    rest = np.flatnonzero(~small)
+    rest = np.flatnonzero(~ok)
     if rest.size:
         ops = a0[rest] + loads[rest, None, None] * a1[rest]
         vals[rest], vecs[rest], inv[rest], ok[rest] = _lapack(ops)
