@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..blocks import eig_affine, eigvals_affine_blocks
+from ..blocks import eig_affine
 from ..critical import FLOOR, TOL_CLUSTER, TOL_DUPLICATE
 from ..eigen import cluster_participation
 from .jobs import _EPS4, _Job, _Stack, gather
-from .scan import _brackets
+from .scan import _brackets, classify_points
 
 Array = NDArray[np.float64]
 
@@ -56,12 +56,8 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
         mid = 0.5 * (a[half] + b[half])
         keep = (mid != a[half]) & (mid != b[half])
         half, mid = half[keep], mid[keep]
-        if half.size:
-            sub = [jobs[r] for r in half]
-            a0, a1, blocks = gather(sub)
-            unstable, _ = _Stack(None, True).classify_values(eigvals_affine_blocks(a0, a1, mid[:, None], blocks)[:, 0])
-            for j in sub:
-                j.evaluations += 1
+        if half.size:  # the engine's unstable_at(mid)
+            unstable, _ = classify_points([jobs[r] for r in half], mid.tolist(), {})
             b[half[unstable]], a[half[~unstable]] = mid[unstable], mid[~unstable]
         rows = np.sort(np.concatenate([back, half]))
         if not rows.size:

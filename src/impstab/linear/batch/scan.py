@@ -200,27 +200,42 @@ def _bubbles(jobs: list[_Job], where: list[tuple[int, int]], column: int, errors
         runs[r] = (gen, next(gen))
         found[r] = None
     while runs:
-        step: dict[bool, list] = {}
-        for r in list(runs):
+        rows = list(runs)
+        unstable, ind = classify_points([jobs[r] for r in rows], [runs[r][1] for r in rows], errors)
+        for k, r in enumerate(rows):
+            gen, x = runs.pop(r)
+            if id(jobs[r]) in errors:
+                continue
+            if unstable[k]:
+                found[r] = float(x)
+                continue
             try:
-                step.setdefault(jobs[r].undamped, []).append((r, jobs[r].point_op(runs[r][1])))
-            except Exception as exc:  # noqa: BLE001 - reported per design
-                errors[id(jobs[r])] = exc
-                del runs[r]
-        for undamped, items in step.items():
-            ops = np.concatenate([op for _, op in items])
-            unstable, ind = _Stack(ops, undamped).classify(np.zeros(len(ops)))
-            for k, (r, _) in enumerate(items):
-                jobs[r].evaluations += 1
-                gen, x = runs.pop(r)
-                if unstable[k]:
-                    found[r] = float(x)
-                    continue
-                try:
-                    runs[r] = (gen, gen.send(float(ind[k, column])))
-                except StopIteration:
-                    pass
+                runs[r] = (gen, gen.send(float(ind[k, column])))
+            except StopIteration:
+                pass
     return found
+
+
+def classify_points(jobs: list[_Job], loads: list[float], errors: dict) -> tuple[NDArray[np.bool_], Array]:
+    """The engine's classification of each job at its own load, batched (``engine.classify``).
+
+    Returns the unstable flags and the indicators ``(len(jobs), 2)``; a job whose operator
+    cannot be formed is recorded in ``errors`` (its row is stable, NaN).
+    """
+    unstable = np.zeros(len(jobs), dtype=bool)
+    ind = np.full((len(jobs), 2), np.nan)
+    step: dict[bool, list] = {}
+    for k, (job, x) in enumerate(zip(jobs, loads)):
+        try:
+            step.setdefault(job.undamped, []).append((k, job.point_op(x)))
+        except Exception as exc:  # noqa: BLE001 - reported per design
+            errors[id(job)] = exc
+    for undamped, items in step.items():
+        rows = [k for k, _ in items]
+        unstable[rows], ind[rows] = _Stack(np.concatenate([op for _, op in items]), undamped).classify(np.zeros(len(items)))
+        for k in rows:
+            jobs[k].evaluations += 1
+    return unstable, ind
 
 
 def _bounded_minimum(x1: float, x2: float, xatol: float, maxfun: int = 500):
