@@ -215,24 +215,6 @@ def test_a_failed_data_write_leaves_the_chunk_not_done(tmp_path, monkeypatch):
     assert np.isfinite(_records(store)[:, 0]).sum() == 1 and _records(store)[1, 1] == 1.0
 
 
-def test_run_leaves_the_garbage_collector_as_it_found_it(tmp_path):
-    """run_study freezes the objects that exist before it for its duration, and only if the
-    caller has not frozen any itself."""
-    import gc
-
-    study = load_study(write_study(tmp_path, GRID_6x5))
-    assert gc.get_freeze_count() == 0
-    run_study(study, None)
-    assert gc.get_freeze_count() == 0
-    gc.freeze()
-    try:
-        frozen = gc.get_freeze_count()
-        run_study(study, None)
-        assert gc.get_freeze_count() > frozen // 2  # still frozen (some frozen objects died meanwhile)
-    finally:
-        gc.unfreeze()
-
-
 def test_chunk_pauses_the_collector_and_restores_it(tmp_path, monkeypatch):
     """evaluate_chunk runs with the cyclic collector off and leaves it as it found it, also
     when the chunk fails."""

@@ -11,11 +11,9 @@ are not marked done.
 
 from __future__ import annotations
 
-import gc
 import logging
 import os
 import threading
-from contextlib import contextmanager
 from typing import Callable, Iterator
 
 from ..errors import ModelError
@@ -76,35 +74,6 @@ def run_study(
         raise ModelError("--workers", workers, "give either --workers or --scheduler, not both")
     if workers is not None and not (isinstance(workers, int) and workers >= 1):
         raise ModelError("--workers", workers, "must be a whole number >= 1")
-    with _old_objects_frozen():
-        return _run(study, store, workers, scheduler, client, progress)
-
-
-@contextmanager
-def _old_objects_frozen() -> Iterator[None]:
-    """Keep the objects that exist now out of the cyclic garbage collector's full collections.
-
-    The imported libraries hold some 10^5 long-lived objects; every full collection walks them
-    all (about 0.1 s here), and a study's many short-lived objects trigger one every few
-    thousand designs (10 to 20 us per design). ``gc.freeze`` moves them to the permanent
-    generation for the duration and ``gc.unfreeze`` hands them back (one of them that becomes
-    garbage meanwhile is collected afterwards); collections go on as usual for everything
-    created during the run. Nothing is done when objects are frozen already (the caller manages
-    that itself).
-    """
-    if gc.get_freeze_count():
-        yield
-        return
-    gc.freeze()
-    try:
-        yield
-    finally:
-        gc.unfreeze()
-
-
-def _run(study: Study, store: str | os.PathLike[str] | None, workers: int | None, scheduler: str | None,
-         client, progress: bool) -> StudyResult:
-    """The body of :func:`run_study` (arguments checked)."""
     plan = plan_chunks(study)
     st = StudyStore.create_or_resume(study, plan, store)
     todo = [i for i, d in enumerate(st.done()) if not d]
