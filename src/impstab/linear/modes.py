@@ -8,6 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.model import DOF_NAMES, Model
+from .critical import TOL_DUPLICATE
 from .eigen import kinetic_shares
 from .linearize import linearize
 from .system import LinearSystem
@@ -120,10 +121,6 @@ def _undamped_eigenpairs(system: LinearSystem):
     return lam, x
 
 
-#: relative distance within which eigenvalues are one repeated eigenvalue (as the engine's)
-TOL_REPEATED = 1e-9
-
-
 def _canonical_repeated(vals: NDArray, vecs: NDArray, m_diag: NDArray) -> NDArray:
     """A basis of each repeated eigenvalue's eigenspace that does not depend on the eigensolver.
 
@@ -141,7 +138,7 @@ def _canonical_repeated(vals: NDArray, vecs: NDArray, m_diag: NDArray) -> NDArra
     start = 0
     while start < len(vals):
         stop = start + 1
-        while stop < len(vals) and abs(vals[stop] - vals[start]) <= TOL_REPEATED * scale:
+        while stop < len(vals) and abs(vals[stop] - vals[start]) <= TOL_DUPLICATE * scale:
             stop += 1
         if stop - start > 1:
             v = vecs[:, start:stop]
