@@ -50,31 +50,23 @@ from impstab.studies.plan import plan_chunks
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "imp_symmetric.toml"
 
-STUDY = """schema_version = 1
-name = "benchmark 100 x 100"
-model = "{model}"
-[[parameters]]
-path = "mount_rings[0].x"
-values = {{ start = 0.1, stop = 0.4, num = {n} }}
-[[parameters]]
-path = "mount_rings[0].k_shear"
-values = {{ start = 5e3, stop = 5e4, num = {n}, scale = "log" }}
-[execution]
-chunk_size = {chunk}
-"""
 COUPLED_EXAMPLE = EXAMPLE.with_name("imp_asymmetric.toml")
-COUPLED_STUDY = """schema_version = 1
-name = "benchmark 100 x 100, coupled layout"
+STUDY = """schema_version = 1
+name = "benchmark {n} x {n}{label}"
 model = "{model}"
 [[parameters]]
-path = "mounts[0].position[0]"
-values = {{ start = 0.2, stop = 0.4, num = {n} }}
+path = "{x}"
+values = {{ start = {x0}, stop = {x1}, num = {n} }}
 [[parameters]]
-path = "mounts[0].k_shear"
+path = "{k}"
 values = {{ start = 5e3, stop = 5e4, num = {n}, scale = "log" }}
 [execution]
 chunk_size = {chunk}
 """
+#: the symmetric example over its ring's x and shear stiffness
+RING = dict(label="", x="mount_rings[0].x", x0=0.1, x1=0.4, k="mount_rings[0].k_shear")
+#: the asymmetric example over its first mount's x and shear stiffness
+MOUNT = dict(label=", coupled layout", x="mounts[0].position[0]", x0=0.2, x1=0.4, k="mounts[0].k_shear")
 
 
 def scan_operator_time(study, designs: np.ndarray, n_scan: int = 64) -> float:
@@ -116,7 +108,7 @@ def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng) -> dict:
     model = tmp / "coupled.toml"
     model.write_text(text.replace("[analysis]", '[analysis]\nlinearization = "classical"', 1))
     path = tmp / "coupled_study.toml"
-    path.write_text(COUPLED_STUDY.format(model=model.as_posix(), n=n, chunk=chunk))
+    path.write_text(STUDY.format(model=model.as_posix(), n=n, chunk=chunk, **MOUNT))
     study = load_study(path)
     run_study(study, None)  # warm-up
     seconds, _ = timed_study(study, tmp / "coupled.zarr")
@@ -178,7 +170,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmpdir:
         tmp = Path(tmpdir)
         path = tmp / "study.toml"
-        path.write_text(STUDY.format(model=EXAMPLE.as_posix(), n=args.n, chunk=args.chunk))
+        path.write_text(STUDY.format(model=EXAMPLE.as_posix(), n=args.n, chunk=args.chunk, **RING))
         study = load_study(path)
         n = study.size
         run_study(load_study(path), None)  # warm-up of the whole path (JIT cache, imports)
