@@ -34,7 +34,7 @@ class StudyResult:
 
     @classmethod
     def from_store(cls, st) -> "StudyResult":
-        return cls(st.open_dataset().load(), None if st.path is None else str(st.path))
+        return cls(st.load_dataset(), None if st.path is None else str(st.path))
 
     # -- views --------------------------------------------------------------------------------
     @property

@@ -76,6 +76,7 @@ class StudyStore:
         self.path = path
         self._arrays: dict = {}  # the result arrays, opened once
         self._records: np.ndarray | None = None  # the progress records as last read or written
+        self._written: dict[int, dict[str, np.ndarray]] = {}  # chunk data written by this object
 
     # -- creation and resumption -------------------------------------------------------------
     @classmethod
@@ -137,6 +138,7 @@ class StudyStore:
         row = np.array([time.time(), runs + 1.0, result.seconds, float(result.evaluations)])
         self._arrays["progress/chunks"][result.index, :] = row
         self._records[result.index] = row
+        self._written[result.index] = result.data
 
     def begin_run(self, executor: str) -> int:
         """Record the start of a run in the store's history; returns its position."""
@@ -163,6 +165,25 @@ class StudyStore:
 
         store = self.group.store if self.path is None else str(self.path)
         return tidy(xr.open_zarr(store, consolidated=True, chunks=None))
+
+    def load_dataset(self):
+        """The results as an xarray Dataset in memory.
+
+        When this object wrote every chunk of the study (a run from the start), the result
+        variables are assembled from the chunks it wrote instead of being read back: the same
+        values, without reading every chunk of every variable again (some 0.3 ms each). The
+        attributes, coordinates and dtypes come from the store either way.
+        """
+        ds = self.open_dataset()
+        if len(self._written) == self.plan.n_chunks and all(v in self._written[0] for v in ds.data_vars):
+            full = {}
+            for name in ds.data_vars:
+                arr = np.empty(ds[name].shape, dtype=ds[name].dtype)
+                for index, data in self._written.items():
+                    arr[self.plan.slices(index)] = data[name]
+                full[name] = ds[name].copy(data=arr)
+            ds = ds.assign(full)
+        return ds.load()
 
 
 def tidy(ds):
