@@ -57,3 +57,20 @@ def test_local_cluster_workers_keep_adaptive_malloc(monkeypatch):
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
                                   silence_logs=logging.ERROR) as cluster, distributed.Client(cluster) as client:
         assert set(client.run(_malloc_env).values()) == {str(default)}  # what the plain cluster does
+
+
+def _worker_background(dask_worker):
+    import dask
+
+    return ("profile" in dask_worker.periodic_callbacks, dask.config.get("distributed.admin.tick.interval"))
+
+
+def test_local_cluster_workers_run_without_the_profiler():
+    """The 10 ms statistical profiler and the 20 ms tick are off on the workers started here."""
+    from impstab.studies.execute import local_cluster
+
+    with local_cluster(1, dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        assert set(client.run(_worker_background).values()) == {(False, "1s")}
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=logging.ERROR) as cluster, distributed.Client(cluster) as client:
+        assert set(client.run(_worker_background).values()) == {(True, "20ms")}  # what the plain cluster does
