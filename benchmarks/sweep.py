@@ -31,8 +31,8 @@ Measured in one run on this machine:
 
 Ends with one JSON line:
 ``{"designs_per_s", "speedup_vs_loop", "lapack_fraction", "workers_scaling": {"1", "2"}, ...}``,
-with ``workers_scaling_at_scale`` (``designs``, ``"1"``, ``"2"``, ``client_cpu_share_2``) among
-the extra keys.
+with ``workers_scaling_at_scale`` (``designs``, ``"1"``, ``"2"``, ``client_cpu_share_2``,
+``workers_cpu_s``) among the extra keys.
 """
 
 from __future__ import annotations
@@ -188,13 +188,13 @@ def scaling(study, tmp: Path, repeats: int) -> tuple[dict, dict]:
         runs[w] = worker_runs(study, tmp, w, repeats)
         out[str(w)] = runs[w]["rate"]
         print(f"dask {w} worker{'s' if w > 1 else ' '}   {runs[w]['rate']:,.0f} designs/s on {study.size} designs "
-              f"(best of {' '.join(f'{t:.2f}' for t in runs[w]['seconds'])} s)")
+              f"(best of {' '.join(f'{t:.2f}' for t in runs[w]['seconds'])} s; workers' CPU {runs[w]['workers_cpu']:.2f} s)")
     two = runs[2]
     share = two["client_cpu"] / (two["client_cpu"] + two["workers_cpu"])
     print(f"worker scaling   {out['2'] / out['1']:.2f}x from 1 to 2 workers; in the 2-worker run this process "
           f"(client, scheduler, store writes) used {two['client_cpu']:.2f} s of CPU, the workers {two['workers_cpu']:.2f} s "
           f"({share:.0%} on this process)")
-    return out, {"client_cpu_share_2": share}
+    return out, {"client_cpu_share_2": share, "workers_cpu_s": {str(w): runs[w]["workers_cpu"] for w in runs}}
 
 
 def main() -> int:
