@@ -264,6 +264,30 @@ def test_wide_brackets_are_halved_in_the_batch_as_the_engine_does(monkeypatch):
         assert got.modes[j] == ",".join(ref.modes)
 
 
+def test_a_bracket_that_cannot_step_back_further_is_left_to_its_engine(monkeypatch):
+    """The engine steps ``a`` back by the bracket width while the exact indicator shows it past
+    the onset, and gives up the exact route once ``a`` no longer moves (clipped at zero). In the
+    batch, such a bracket ends with None (its own engine) while the others in the same step go
+    on: here one already at zero, one stepping back 5 -> 4 -> 2 where the fake refinement ends."""
+    from types import SimpleNamespace
+
+    from impstab.linear.batch import refine
+
+    seen = []
+
+    def fake_once(jobs, a, b):
+        seen.append((a.tolist(), b.tolist()))
+        done = (a > 0) & (a <= 3)
+        res = [("root", float(x)) if d else None for x, d in zip(a, done)]
+        return res, np.where(done, refine._DONE, refine._STEP_BACK).astype(np.int8)
+
+    monkeypatch.setattr(refine, "_refine_once", fake_once)
+    jobs = [SimpleNamespace(p_max=10.0), SimpleNamespace(p_max=10.0)]
+    out = refine._refine(jobs, [(0.0, 1.0), (5.0, 6.0)])
+    assert out == [None, ("root", 2.0)]
+    assert seen == [([0.0, 5.0], [1.0, 6.0]), ([4.0], [6.0]), ([2.0], [6.0])]
+
+
 def test_mixed_batch_of_damped_and_affine_designs():
     """Designs whose jobs are not all affine (a damped, spinning model before a symmetric one):
     each affine job finds its own operators, whatever its place among the batch's jobs."""

@@ -51,7 +51,9 @@ def _refine(jobs: list[_Job], brackets: list[tuple[float, float]]) -> list:
             out[rows[i]] = res[i]
         back = rows[retry == _STEP_BACK]
         new_a = np.clip(2 * a[back] - b[back], 0.0, p_max[back])
-        back, a[back] = back[new_a != a[back]], new_a
+        moved = new_a != a[back]  # one that cannot step back is left to its engine (None)
+        back = back[moved]
+        a[back] = new_a[moved]
         half = rows[retry == _BISECT]
         mid = 0.5 * (a[half] + b[half])
         keep = (mid != a[half]) & (mid != b[half])
