@@ -36,7 +36,7 @@ from scipy.integrate import solve_ivp
 
 import impstab
 from impstab.dynamics.simulate import default_step
-from impstab.linear.kinematics import euler_zyx_to_matrix
+from impstab.kinematics import euler_zyx_to_matrix
 
 # the Exudyn model is the peer test's own, one implementation for both
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "dynamics"))

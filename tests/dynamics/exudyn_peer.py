@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from impstab.linear.kinematics import euler_zyx_to_matrix
+from impstab.kinematics import euler_zyx_to_matrix
 
 
 def exudyn_system(model, thrust, eta0, nu0, t_end, steps):

@@ -8,7 +8,7 @@ from _dyn_models import symmetric
 from exudyn_peer import exudyn_system
 
 import impstab
-from impstab.linear.kinematics import euler_zyx_to_matrix
+from impstab.kinematics import euler_zyx_to_matrix
 from impstab.model import model_from_dict
 
 exu = pytest.importorskip("exudyn")

@@ -19,7 +19,7 @@ from scipy.spatial.transform import Rotation
 
 import impstab
 from impstab.dynamics.simulate import default_step
-from impstab.linear.kinematics import euler_zyx_to_matrix
+from impstab.kinematics import euler_zyx_to_matrix
 from impstab.model import load_model, model_from_dict
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

@@ -16,7 +16,7 @@ from scipy.optimize import linear_sum_assignment
 from _dyn_models import asymmetric, symmetric
 
 from impstab import linearize
-from impstab.linear.kinematics import euler_zyx_to_matrix, matrix_to_euler_zyx, skew
+from impstab.kinematics import euler_zyx_to_matrix, matrix_to_euler_zyx, skew
 from impstab.model import model_from_dict
 from impstab.model.body import rigid_body_coriolis_matrix
 from impstab.dynamics.system import evaluate_rhs, mount_loads, pack_dynamics

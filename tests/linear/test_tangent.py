@@ -12,7 +12,7 @@ import pytest
 from conftest import asymmetric_model_dict, ring_model_dict
 
 from impstab import linearize
-from impstab.linear.kinematics import rigid_map, rotation_from_vector, skew
+from impstab.kinematics import rigid_map, rotation_from_vector, skew
 from impstab.linear.linearize import pack_model
 from impstab.linear.tangent import pose_forces
 from impstab.model import model_from_dict

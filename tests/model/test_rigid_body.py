@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from impstab.linear.kinematics import skew
+from impstab.kinematics import skew
 from impstab.model.body import RigidBody, rigid_body_coriolis_matrix, rigid_body_mass_matrix
 
 

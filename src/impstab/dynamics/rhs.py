@@ -37,7 +37,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..linear.so3 import _jinv, _log_so3
+from ..kinematics.so3 import _jinv, _log_so3
 
 __all__ = ["rhs_into", "mount_loads_series", "PITCH_LIMIT", "KIND_MODEL", "KIND_LINEAR"]
 

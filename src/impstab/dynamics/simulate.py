@@ -9,7 +9,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ModelError
-from ..linear.kinematics import matrix_to_euler_zyx
+from ..kinematics import matrix_to_euler_zyx
 from ..linear.linearize import linearize
 from ..model.model import DOF_NAMES, Model
 from .growth import classify, fit_run

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _skew
+from ..kinematics.so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _skew
 
 __all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_forms", "MAX_PREDICTOR"]
 

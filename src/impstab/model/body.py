@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..linear.kinematics import skew
+from ..kinematics import skew
 
 __all__ = ["RigidBody", "rigid_body_mass_matrix", "rigid_body_coriolis_matrix"]
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..linear.kinematics import rigid_map6
+from ..kinematics import rigid_map6
 
 __all__ = ["Hull", "FluidLoading", "segment_added_mass_matrix", "FLUID_MODELS"]
 

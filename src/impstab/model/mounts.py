@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..linear.kinematics import rigid_map6
+from ..kinematics import rigid_map6
 
 __all__ = ["Mount", "axial_shear_matrix", "ring_positions", "condense", "elastic_stiffness", "mount_damping"]
 

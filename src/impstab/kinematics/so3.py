@@ -1,7 +1,7 @@
 """Compiled SO(3) primitives: skew matrices, exponential and logarithm, left Jacobian.
 
 Used by the force law and its tangent (:mod:`impstab.linear.tangent`), the nonlinear equations
-of motion and the plain-NumPy helpers of :mod:`impstab.linear.kinematics`. Compiled with numba
+of motion and the plain-NumPy helpers of :mod:`impstab.kinematics`. Compiled with numba
 (``cache=True``); with ``NUMBA_DISABLE_JIT=1`` the same code runs as plain Python.
 """
 

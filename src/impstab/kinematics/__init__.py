@@ -1,4 +1,6 @@
-"""Small-rotation and finite-rotation kinematics shared by the linear and nonlinear models.
+"""Kinematics, the ground floor of impstab: skew matrices, rigid-body maps, SO(3), Euler angles.
+
+Used by the model, the linear analyses and the nonlinear dynamics alike; it imports none of them.
 
 Conventions (THEORY 1): ``skew(a) @ b == cross(a, b)``; the rigid-body map of a body point
 at arm ``r`` (from the reference point A) is ``d = rigid_map(r) @ q`` with
