@@ -108,7 +108,7 @@ BAD = [
     ("", 'path = "body.cg"\nvalues = [0.1]', "parameters[0].path", "not one value"),
     ("", 'path = "mount_rings.x"\nvalues = [0.1]', "parameters[0].path", "is a list"),
     ("", 'path = "mount_rings[0].x"\nvalues = { start = 0.1, stop = 0.4 }', "parameters[0].values.num", "required"),
-    ("", 'path = "mount_rings[0].k_shear"\nvalues = [-1.0, 1e4]', "parameters[0].values", "greater than or equal to 0"),
+    ("", 'path = "mount_rings[0].k_shear"\nvalues = [-1.0, 1e4]', "parameters[0].values", "must be between 0 and 1e+13 N/m"),
     ("", 'path = "mount_rings[0].count"\nvalues = { start = 1, stop = 2, num = 3 }', "parameters[0].values", "integer"),
     ("", 'path = "mount_rings[0].x"\nvalues = { start = 0.0, stop = 0.4, num = 3, scale = "log" }', "parameters[0].values", "> 0"),
     ("", 'path = "mount_rings[0].x"\ndistribution = { kind = "normal", mean = 0.3, std = 0.01 }', "parameters[0].distribution", "random"),

@@ -18,6 +18,7 @@ from typing import Annotated, Any, Literal, Union
 import numpy as np
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
+from ..model.assemble import rule_text
 from ..model.schema import ModelFile
 
 __all__ = ["ParameterPath", "parse_path", "resolve_path", "set_values", "variant_dict"]
@@ -107,8 +108,7 @@ class ParameterPath:
         try:
             return self.adapter.validate_python(value)
         except ValidationError as err:
-            msg = err.errors()[0]["msg"].replace("Input should be", "must be")
-            raise ValueError(msg[0].lower() + msg[1:]) from None
+            raise ValueError(rule_text(err.errors()[0])) from None
 
 
 def resolve_path(path: str, base: dict) -> ParameterPath:

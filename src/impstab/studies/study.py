@@ -21,15 +21,20 @@ from numpy.typing import NDArray
 from pydantic import ValidationError
 
 from ..errors import ModelError
-from ..model.assemble import format_location, model_from_dict, read_toml
+from ..limits import MAX_STUDY_BYTES
+from ..model.assemble import _plain_loc, check_nesting, format_location, model_from_dict, parse_toml, read_text, rule_text
 from .paths import ParameterPath, resolve_path
 from .sampling import axis_values, check_distribution, map_samples, unit_samples
 from .schema import ParameterSpec, RangeSpec, StudyFile
 
-__all__ = ["Study", "Parameter", "load_study", "study_from_dict", "describe", "MAX_DESIGNS"]
+__all__ = ["Study", "Parameter", "load_study", "study_from_dict", "describe", "MAX_DESIGNS", "result_bytes"]
 
 #: largest number of designs in one study
 MAX_DESIGNS = 100_000_000
+#: bytes per design of each output in memory (floats 8, kind codes 1, "modes" up to 36 characters
+#: of 4 bytes), and of the status code and the message (an object pointer) of every design
+_OUTPUT_BYTES = {"kind": 1, "undamped_kind": 1, "modes": 144}
+_DESIGN_BYTES = 1 + 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -95,24 +100,32 @@ def _shown(value: Any) -> Any:
 
 def _schema_error(err: ValidationError) -> ModelError:
     first = err.errors()[0]
-    loc = tuple(p for p in first["loc"] if not (isinstance(p, str) and ("[" in p or p.startswith("function-"))))
+    loc = tuple(p for p in _plain_loc(first["loc"]) if not (isinstance(p, str) and "[" in p))
     field = format_location(loc)
     kind = first["type"]
     if kind == "extra_forbidden":
         return ModelError(field, first.get("input"), "unknown key (check the spelling against the study-file schema)")
     if kind == "missing":
         return ModelError(field, None, "is required")
-    msg = first["msg"].replace("Value error, ", "").replace("Input should be", "must be")
-    return ModelError(field, first.get("input"), msg[0].lower() + msg[1:])
+    return ModelError(field, first.get("input"), rule_text(first))
+
+
+def result_bytes(n_designs: int, n_parameters: int, outputs: tuple[str, ...] | list[str], grid: bool) -> int:
+    """Estimated memory of a study's results (bytes): every output, status and message of every
+    design, and the parameter values (one axis each for a grid, one column each otherwise)."""
+    per_design = _DESIGN_BYTES + sum(_OUTPUT_BYTES.get(name, 8) for name in outputs)
+    return n_designs * (per_design + (0 if grid else 8 * n_parameters))
 
 
 def _checked(par: ParameterPath, values: list, field: str) -> NDArray:
-    """Values converted by the field's schema rule, as an array of the field's type."""
+    """Values checked with the field's strict schema rule, as an array of the field's type.
+
+    A list is taken as written: ``[true, false]`` is not a list of numbers and ``[3.0, 4.0]``
+    not a list of integers (a range of an integer field gives integers itself).
+    """
     out = []
     for v in values:
         v = v.item() if isinstance(v, np.generic) else v
-        if par.kind == "int" and isinstance(v, float) and v.is_integer():
-            v = int(v)
         try:
             out.append(par.check(v))
         except ValueError as exc:
@@ -183,6 +196,7 @@ def study_from_dict(
     """
     if not isinstance(data, dict):
         raise ModelError("(study file)", type(data).__name__, "must be a table of study keys")
+    check_nesting(data)
     if "schema_version" not in data:
         raise ModelError("schema_version", None, "is required (schema_version = 1)")
     try:
@@ -191,7 +205,8 @@ def study_from_dict(
         raise _schema_error(err) from None
     model_path = Path(base_dir) / doc.model
     try:
-        base = read_toml(model_path, "model")
+        model_text = read_text(model_path, "model")
+        base = parse_toml(model_text, model_path, "model")
     except ModelError as err:
         raise ModelError("model", doc.model, f"{err.rule} ({model_path})") from None
     try:
@@ -219,6 +234,14 @@ def study_from_dict(
         size = doc.sampling.n
     if size > MAX_DESIGNS:
         raise ModelError("parameters", f"{size} designs", f"more than {MAX_DESIGNS} designs in one study")
+    needed = result_bytes(size, len(paths), doc.outputs, method == "grid")
+    if needed > MAX_STUDY_BYTES:
+        where = "sampling.n" if method != "grid" else "parameters"
+        raise ModelError(
+            where, f"{size} designs",
+            f"the results of {size} designs with {len(doc.outputs)} outputs would take about "
+            f"{needed / 1024**3:.3g} GiB (limit {MAX_STUDY_BYTES / 1024**3:g} GiB): fewer designs or outputs",
+        )
     if method != "grid":
         u = unit_samples(method, size, len(paths), doc.sampling.seed)
         columns = [_sample_column(s, p, i, u[:, i]) for i, (s, p) in enumerate(zip(doc.parameters, paths))]
@@ -232,7 +255,7 @@ def study_from_dict(
         base_model=base,
         model_name=model.name,
         study_text=text if text is not None else json.dumps(data, default=str),
-        model_text=model_path.read_text(encoding="utf-8"),
+        model_text=model_text,
         fingerprint=hashlib.sha256(canonical.encode()).hexdigest(),
         source=source,
         model_source=str(model_path),
@@ -249,8 +272,8 @@ def load_study(path: str | os.PathLike[str]) -> Study:
         One line naming the field, the value and the rule; nothing has run and nothing is written.
     """
     p = Path(path)
-    data = read_toml(p, "study file")
-    text = p.read_text(encoding="utf-8")
+    text = read_text(p, "study file")
+    data = parse_toml(text, p, "study file")
     return study_from_dict(data, p.parent, source=str(p), text=text)
 
 
