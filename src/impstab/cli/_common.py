@@ -5,13 +5,14 @@ from __future__ import annotations
 import json
 import math
 import sys
+import warnings
 from typing import Any
 
 import click
 
-from ..errors import ModelError, NumericalError
+from ..errors import ModelError, NumericalError, printable
 
-__all__ = ["run_guarded", "print_json", "jsonable", "BadInput", "console", "check_number"]
+__all__ = ["run_guarded", "print_json", "jsonable", "BadInput", "console", "check_number", "user_text", "at_thrust"]
 
 
 class BadInput(click.ClickException):
@@ -48,16 +49,49 @@ def console(stderr: bool = False):
     return Console(highlight=False, width=None if stream.isatty() else 160, stderr=stderr)
 
 
-def check_number(field: str, value: float | None, positive: bool = False, nonneg: bool = False) -> None:
-    """Reject a non-finite (or, as asked, non-positive / negative) command-line number."""
+def check_number(field: str, value: float | None, positive: bool = False, nonneg: bool = False,
+                 kind: str | None = None) -> float | None:
+    """A command-line number within its physical range, or a ModelError naming the option.
+
+    ``kind`` names a range of :data:`impstab.limits.RANGES` (``"thrust"``, ``"duration"``, ...);
+    without it the number must be finite (within +-1e15), and > 0 or >= 0 as asked.
+    """
+    from ..limits import check_number as _check
+
     if value is None:
-        return
-    if not math.isfinite(value):
-        raise ModelError(field, value, "must be a finite number")
-    if positive and value <= 0:
-        raise ModelError(field, value, "must be > 0")
-    if nonneg and value < 0:
-        raise ModelError(field, value, "must be >= 0")
+        return None
+    if kind is None:
+        kind = "positive" if positive else "nonnegative" if nonneg else "number"
+    return _check(field, value, kind)
+
+
+def at_thrust(option: str, thrust: float, model, compute):
+    """``compute()`` at a command-line thrust (N). Where no static equilibrium is found there and
+    the model has lost stability at or below that thrust, the thrust is beyond what the model
+    can carry: bad input naming ``option`` (exit 2), with the critical thrust. A failure below
+    the critical thrust stays a numerical failure (exit 1)."""
+    try:
+        return compute()
+    except NumericalError as exc:
+        from ..linear.critical_thrust import critical_thrust
+
+        try:
+            crit = critical_thrust(model, thrust_max=max(thrust, model.analysis.thrust_max))
+        except (NumericalError, ModelError):
+            raise exc from None
+        if crit.thrust is not None and thrust >= crit.thrust:
+            raise ModelError(option, thrust, f"no static equilibrium found at this thrust: the model loses stability "
+                                             f"at {crit.thrust:.6g} N ({crit.kind}) and its mounts do not carry "
+                                             "this thrust") from None
+        raise
+
+
+def user_text(value: object) -> str:
+    """A user string (model name, path, key) ready for a rich console: control characters
+    shown escaped (:func:`impstab.errors.printable`) and rich markup brackets escaped."""
+    from rich.markup import escape
+
+    return escape(printable(value))
 
 
 def print_json(obj: dict) -> None:
@@ -65,26 +99,104 @@ def print_json(obj: dict) -> None:
     sys.stdout.write(json.dumps(jsonable(obj)) + "\n")
 
 
+#: click >= 8.2 raises this for a group called without a command (older versions print the help)
+_NO_ARGS_IS_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
+
+
+def _say(kind: str, text: object) -> None:
+    """One line on stderr: ``impstab: <kind>: <text>`` with the text made printable."""
+    click.echo(f"impstab: {kind}: {printable(text)}", err=True)
+
+
+def _warning_lines(caught: list) -> list[str]:
+    """Distinct warnings of a run, one line each (numpy's floating-point warnings included)."""
+    lines: list[str] = []
+    for w in caught:
+        text = f"{w.category.__name__}: {w.message}" if issubclass(w.category, RuntimeWarning) else str(w.message)
+        if text not in lines:
+            lines.append(text)
+    return lines
+
+
 def run_guarded(command: click.Command, argv: list[str] | None) -> int:
-    """Run a click command, mapping errors to one-line messages and exit codes."""
+    """Run a click command, mapping errors to one-line messages and exit codes.
+
+    Exit codes: 0 success, 2 bad input (a :class:`~impstab.errors.ModelError` or a usage
+    error: exactly one line on stderr), 1 a numerical or internal failure (one line),
+    130 interrupted. Warnings raised during the run (numpy floating-point warnings among them)
+    never spill as multi-line tracebacks: after a successful or failed computation each distinct
+    one is reported on one line; after bad input only the error line is printed. User strings
+    in every message are shown with control characters escaped.
+    """
+    caught: list = []
+    code = 1
     try:
-        # outside standalone mode click returns ctx.exit(n)'s code instead of raising it
-        return int(command.main(args=argv, prog_name="impstab", standalone_mode=False) or 0)
-    except ModelError as exc:
-        click.echo(f"impstab: error: {exc}", err=True)
-        return 2
-    except click.exceptions.Exit as exc:
-        return int(exc.exit_code or 0)
-    except click.exceptions.Abort:
-        click.echo("impstab: aborted", err=True)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                # outside standalone mode click returns ctx.exit(n)'s code instead of raising it
+                code = int(command.main(args=argv, prog_name="impstab", standalone_mode=False) or 0)
+            except ModelError as exc:
+                code = 2
+                _say("error", exc)
+            except click.exceptions.Exit as exc:
+                code = int(exc.exit_code or 0)
+            except (click.exceptions.Abort, KeyboardInterrupt):
+                code = 130
+                _say("error", "interrupted")
+            except _NO_ARGS_IS_HELP as exc:  # a bare command group: its help, as with --help
+                click.echo(exc.ctx.get_help() if exc.ctx is not None else "")
+                code = 0
+            except click.ClickException as exc:
+                code = 2 if isinstance(exc, click.UsageError) else exc.exit_code
+                _say("error", exc.format_message())
+            except NumericalError as exc:
+                code = 1
+                _say("numerical failure", exc)
+            except BrokenPipeError:
+                _silence_stdout()
+                return 1
+            except RecursionError:
+                code = 2
+                _say("error", "the input is nested too deeply to be read")
+            except MemoryError:
+                code = 1
+                _say("error", "out of memory")
+            except OSError as exc:
+                code = 2 if exc.filename is not None else 1
+                where = f"{exc.filename}: " if exc.filename is not None else ""
+                _say("error", f"{where}{exc.strerror or type(exc).__name__}")
+            except Exception as exc:  # noqa: BLE001 - last line of defence: no traceback for users
+                code = 1
+                _say("internal error", f"{type(exc).__name__}: {exc}")
+    except BrokenPipeError:
+        _silence_stdout()
         return 1
-    except click.ClickException as exc:
-        code = 2 if isinstance(exc, click.UsageError) else exc.exit_code
-        click.echo(f"impstab: error: {exc.format_message()}", err=True)
-        return code
-    except NumericalError as exc:
-        click.echo(f"impstab: numerical failure: {exc}", err=True)
-        return 1
-    except Exception as exc:  # noqa: BLE001 - last line of defence: no traceback for users
-        click.echo(f"impstab: internal error: {type(exc).__name__}: {exc}", err=True)
-        return 1
+    if code != 2:
+        for line in _warning_lines(caught):
+            _say("warning", line)
+    _flush()
+    return code
+
+
+def _flush() -> None:
+    """Flush stdout now, so that a closed pipe is noticed here and not at interpreter exit."""
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+    except (OSError, ValueError):
+        pass
+
+
+def _silence_stdout() -> None:
+    """After the reader of stdout went away: point stdout at /dev/null (Python would otherwise
+    print a traceback when it flushes stdout at exit)."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):
+        pass

@@ -8,7 +8,8 @@ import click
 import numpy as np
 
 from ..errors import ModelError
-from ._common import check_number, console, print_json
+from ..limits import MAX_LOCUS_STEPS
+from ._common import at_thrust, check_number, console, print_json, user_text
 
 __all__ = ["commands"]
 
@@ -27,6 +28,17 @@ def _fmt(x: float | None, unit: str = "", digits: int = 6) -> str:
     return f"{x:.{digits}g}{(' ' + unit) if unit else ''}"
 
 
+def _margin_text(res) -> str:
+    """The margin as ``critical`` and ``check`` both show it, with what it means."""
+    if res.operating_thrust is None:
+        return "- (no operating thrust)"
+    if res.margin is None:
+        return f"> {res.thrust_max / res.operating_thrust:.4g} (stable up to thrust_max)"
+    if res.margin < 1.0:
+        return f"{res.margin:.4g} [red](UNSTABLE at the operating thrust)[/red]"
+    return f"{res.margin:.4g}"
+
+
 @click.command("check")
 @click.argument("model_file", type=click.Path(dir_okay=False))
 def check_cmd(model_file: str) -> None:
@@ -36,10 +48,12 @@ def check_cmd(model_file: str) -> None:
     from ..linear.modes import modes
     from ..model.model import DOF_NAMES
 
+    from ..linear.critical_thrust import critical_thrust
+
     model = _load(model_file)
     con = console()
     b = model.body
-    con.print(f"[bold]{model.name}[/bold]  ({model_file}): valid, schema_version 1")
+    con.print(f"[bold]{user_text(model.name)}[/bold]  ({user_text(model_file)}): valid, schema_version 1")
     t = Table(title="assembled model", show_header=True)
     t.add_column("item")
     t.add_column("value")
@@ -71,9 +85,15 @@ def check_cmd(model_file: str) -> None:
         t.add_row("added mass m_a", f"{ma:.6g} kg ({ma / ref.added_mass:.4f} x strip theory)")
         t.add_row("added inertia I_a", f"{ia:.6g} kg m^2 ({ia / ref.added_inertia:.4f} x strip theory)")
     t.add_row("analysis", f"thrust_max {model.analysis.thrust_max:g} N, linearization {model.analysis.linearization}")
+    crit = critical_thrust(model)
+    t.add_row("critical thrust", f"{_fmt(crit.thrust, 'N', 10)} ({crit.kind})" if crit.thrust is not None
+              else f"none up to {crit.thrust_max:g} N")
+    t.add_row("margin (critical / operating)", _margin_text(crit))
     con.print(t)
     md = modes(model, 0.0)
     con.print("natural frequencies at zero thrust (Hz): " + ", ".join(f"{f:.4g}" for f in md.frequency_hz))
+    for w in crit.warnings:
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
 
 
 @click.command("modes")
@@ -88,13 +108,19 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
     from ..linear.modes import modes
     from ..model.model import DOF_NAMES
 
-    check_number("--thrust", thrust, nonneg=True)
+    from ..linear.critical_thrust import critical_thrust
+
+    thrust = check_number("--thrust", thrust, kind="thrust_or_zero")
     model = _load(model_file)
-    res = modes(model, thrust, linearization)
+    res = at_thrust("--thrust", thrust, model, lambda: modes(model, thrust, linearization))
+    crit = critical_thrust(model, thrust_max=max(thrust, model.analysis.thrust_max), linearization=linearization)
     if as_json:
-        print_json(res.to_dict())
+        d = res.to_dict()
+        d.update(stable=res.stable, critical_thrust=crit.thrust, critical_kind=crit.kind,
+                 warnings=_modes_warnings(res, crit, thrust))
+        print_json(d)
         return
-    t = Table(title=f"modes of {model.name} at T = {thrust:g} N ({res.linearization})")
+    t = Table(title=f"modes of {user_text(model.name)} at T = {thrust:g} N ({res.linearization})")
     for col in ("mode", "f (Hz)", "omega (rad/s)", "zeta", "growth (1/s)", "dominant"):
         t.add_column(col)
     for name in DOF_NAMES:
@@ -106,8 +132,12 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
         )
     con = console()
     con.print(t)
+    first = (f"stability is first lost at {crit.thrust:.8g} N ({crit.kind})" if crit.thrust is not None
+             else f"stable from 0 to {crit.thrust_max:g} N")
     con.print("shapes: displacement of A (m) and rotation (rad), largest component 1; "
-              + ("stable" if res.stable else "[red]UNSTABLE[/red]"))
+              + ("stable" if res.stable else "[red]UNSTABLE[/red]") + f" at {thrust:g} N; {first}")
+    for w in _modes_warnings(res, crit, thrust):
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
 
 
 @click.command("locus")
@@ -122,9 +152,9 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
     from ..linear.critical_thrust import critical_thrust
     from ..linear.locus import locus
 
-    check_number("--thrust-max", thrust_max, positive=True)
-    if steps < 1 or steps > 100000:
-        raise ModelError("--steps", steps, "must be between 1 and 100000")
+    thrust_max = check_number("--thrust-max", thrust_max, kind="thrust")
+    if steps < 1 or steps > MAX_LOCUS_STEPS:
+        raise ModelError("--steps", steps, f"must be between 1 and {MAX_LOCUS_STEPS}")
     if output is not None and Path(output).suffix.lower() not in (".nc", ".png"):
         raise ModelError("--output", output, "must end in .nc (netCDF; a PNG is written beside it) or .png")
     model = _load(model_file)
@@ -142,9 +172,9 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
     con = console()
     con.print(f"critical thrust: {_fmt(crit.thrust, 'N')} ({crit.kind})")
     if out.suffix.lower() == ".nc":
-        con.print(f"wrote {out} and {png}")
+        con.print(f"wrote {user_text(out)} and {user_text(png)}")
     else:
-        con.print(f"wrote {png}")
+        con.print(f"wrote {user_text(png)}")
 
 
 def _save_png(res, png: Path) -> None:
@@ -174,13 +204,17 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
 
     from ..linear.critical_thrust import critical_thrust
 
-    check_number("--thrust-max", thrust_max, positive=True)
+    thrust_max = check_number("--thrust-max", thrust_max, kind="thrust")
     model = _load(model_file)
+    op = model.thrust.operating
+    if thrust_max is not None and op is not None and thrust_max < op:
+        raise ModelError("--thrust-max", thrust_max, f"must be at least the operating thrust {op:g} N, so that "
+                                                     "the search covers the operating point")
     res = critical_thrust(model, thrust_max=thrust_max, linearization=linearization, all_crossings=all_crossings)
     if as_json:
         print_json(res.to_dict())
         return
-    t = Table(title=f"critical thrust of {model.name}")
+    t = Table(title=f"critical thrust of {user_text(model.name)}")
     t.add_column("quantity")
     t.add_column("value")
     if res.thrust is None:
@@ -191,7 +225,7 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
         t.add_row("frequency", f"{res.frequency_hz:.6g} Hz ({res.omega:.6g} rad/s)")
         t.add_row("modes involved", ", ".join(res.modes))
     t.add_row("operating thrust", _fmt(res.operating_thrust, "N"))
-    t.add_row("margin (critical / operating)", _fmt(res.margin, "", 4))
+    t.add_row("margin (critical / operating)", _margin_text(res))
     t.add_row("undamped critical thrust", _fmt(res.undamped_thrust, "N", 10) + (f" ({res.undamped_kind})" if res.undamped_thrust else ""))
     t.add_row("linearization", res.linearization)
     t.add_row("search range", f"0 to {res.thrust_max:g} N")
@@ -202,7 +236,16 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
     con = console()
     con.print(t)
     for w in res.warnings:
-        con.print(f"[yellow]warning:[/yellow] {w}")
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
+
+
+def _modes_warnings(res, crit, thrust: float) -> list[str]:
+    """What ``modes`` must say when its eigenvalues and the critical-thrust search disagree."""
+    out = []
+    if not res.stable and (crit.thrust is None or thrust < crit.thrust * (1 - 1e-6)):
+        out.append(f"an eigenvalue grows at {thrust:g} N although the critical-thrust search finds the model "
+                   + (f"stable below {crit.thrust:.8g} N" if crit.thrust is not None else f"stable up to {crit.thrust_max:g} N"))
+    return out
 
 
 commands = [check_cmd, modes_cmd, locus_cmd, critical_cmd]

@@ -9,8 +9,9 @@ from pathlib import Path
 
 import click
 
-from ..errors import ModelError
-from ._common import check_number, print_json
+from ..errors import ModelError, printable
+from ..limits import LONG_FACTOR, MAX_OUTPUT_BYTES, MAX_STEPS, MAX_THRUSTS, describe_count
+from ._common import at_thrust, check_number, print_json, user_text
 
 __all__ = ["commands"]
 
@@ -28,13 +29,12 @@ def _thrust_list(thrust: float | None, thrusts: str | None) -> list[float]:
                              "must be numbers separated by commas, e.g. 10000,18012,20000") from None
         if not values:
             raise ModelError("--thrusts", thrusts, "must list at least one thrust")
-        for v in values:
-            check_number("--thrusts", v, nonneg=True)
-        return values
+        if len(values) > MAX_THRUSTS:
+            raise ModelError("--thrusts", f"{len(values)} thrusts", f"must list at most {MAX_THRUSTS} thrusts")
+        return [check_number("--thrusts", v, kind="thrust_or_zero") for v in values]
     if thrust is None:
         raise ModelError("--thrust", None, "give the thrust in N (--thrust T) or several (--thrusts T1,T2,T3)")
-    check_number("--thrust", thrust, nonneg=True)
-    return [thrust]
+    return [check_number("--thrust", thrust, kind="thrust_or_zero")]
 
 
 def _dof_values(option: str, items: tuple[str, ...]) -> dict[str, float]:
@@ -50,9 +50,35 @@ def _dof_values(option: str, items: tuple[str, ...]) -> dict[str, float]:
             v = float(value)
         except ValueError:
             raise ModelError(option, item, "must be DOF=VALUE with a number VALUE") from None
-        check_number(option, v)
-        out[name] = v
+        out[name] = check_number(option, v, kind="displacement" if option == "--displace" else "velocity")
     return out
+
+
+def _check_work(model, step_sizes: list[float], duration: float, dt: float | None, sample: float | None,
+                allow_long: bool) -> None:
+    """Refuse a simulation whose time steps or stored samples exceed the limits, before it runs.
+
+    ``step_sizes`` holds each run's step (s). The samples of a run are every step, at most
+    :data:`~impstab.dynamics.simulate.MAX_SAMPLES` of them, unless ``--sample`` is given; each
+    takes 8 bytes for the time, the 12 states, the thrust, the error estimate and the 6 loads of
+    every mount, twice (the run and the file written from it).
+    """
+    from ..dynamics.simulate import MAX_SAMPLES
+
+    limit = MAX_STEPS * (LONG_FACTOR if allow_long else 1)
+    total = sum(duration / h for h in step_sizes)
+    option = "--dt" if dt is not None else "--duration"
+    if total > limit:
+        hint = "" if allow_long else f"; --allow-long runs up to {describe_count(limit * LONG_FACTOR)} with a progress bar"
+        raise ModelError(option, dt if dt is not None else duration,
+                         f"would need {describe_count(total)} time steps (limit {describe_count(limit)}){hint}")
+    per_sample = 8 * 2 * (15 + 6 * len(model.mounts))
+    samples = sum(math.ceil(duration / sample) if sample is not None else min(math.ceil(duration / h), MAX_SAMPLES)
+                  for h in step_sizes)
+    if samples * per_sample > MAX_OUTPUT_BYTES:
+        raise ModelError("--sample" if sample is not None else option, sample if sample is not None else duration,
+                         f"{describe_count(samples)} stored samples would take {samples * per_sample / 1024**3:.3g} GiB "
+                         f"(limit {MAX_OUTPUT_BYTES / 1024**3:g} GiB): use a longer --sample interval")
 
 
 def _progress(enabled: bool):
@@ -97,7 +123,7 @@ def _write(results, out: Path) -> None:
 def _table(results, model_name: str):
     from rich.table import Table
 
-    t = Table(title=f"time simulation of {model_name}")
+    t = Table(title=f"time simulation of {user_text(model_name)}")
     for col in ("thrust (N)", "class", "envelope", "fitted growth (1/s)", "max Re(λ) (1/s)", "difference",
                 "steps", "run (s)", "status"):
         t.add_column(col)
@@ -110,7 +136,7 @@ def _table(results, model_name: str):
             f"{g.linear_rate:.5g}" if g and g.linear_rate is not None else "-",
             f"{100 * diff:.2f} %" if diff is not None else "-",
             str(r.steps) if r.steps >= 0 else f"{r.rhs_evaluations} f-evals", f"{r.wall_time:.3g}",
-            "completed" if r.completed else f"[red]stopped[/red]: {r.stop_reason}",
+            "completed" if r.completed else f"[red]stopped[/red]: {user_text(r.stop_reason)}",
         )
     return t
 
@@ -130,8 +156,11 @@ def _table(results, model_name: str):
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
               help="netCDF (.nc) or CSV (.csv) file; a PNG of sway and pitch is written beside it")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object (settings and outcome of each run)")
+@click.option("--allow-long", is_flag=True,
+              help=f"run beyond the limit of {MAX_STEPS:.0e} time steps (up to {LONG_FACTOR} times more), "
+                   "with a progress bar on a terminal")
 def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, tol, displace, kick, output,
-                 as_json) -> None:
+                 as_json, allow_long) -> None:
     """Nonlinear time histories of MODEL_FILE from the static equilibrium under thrust.
 
     Writes the time histories (netCDF or CSV) and a PNG of sway and pitch like the paper's
@@ -143,10 +172,10 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     from ..model import load_model
 
     values = _thrust_list(thrust, thrusts)
-    check_number("--duration", duration, positive=True)
-    check_number("--dt", dt, positive=True)
-    check_number("--sample", sample, positive=True)
-    check_number("--tol", tol, positive=True)
+    duration = check_number("--duration", duration, kind="duration")
+    dt = check_number("--dt", dt, kind="time_step")
+    sample = check_number("--sample", sample, kind="time_step")
+    tol = check_number("--tol", tol, kind="tolerance")
     out = Path(output) if output else Path(Path(model_file).stem + "-simulation.nc")
     if out.suffix.lower() not in (".nc", ".csv"):
         raise ModelError("--output", output, "must end in .nc (netCDF) or .csv; a PNG is written beside it")
@@ -155,10 +184,13 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
         pert = {"displacement": _dof_values("--displace", displace), "velocity": _dof_values("--kick", kick)}
     model = load_model(model_file)
     crit = critical_thrust(model, linearization="equilibrium").thrust
+    steps = {v: at_thrust("--thrusts" if thrusts else "--thrust", v, model, lambda v=v: default_step(model, v))
+             for v in values}
     if len(values) > 1 and dt is None:  # one time grid for all runs
-        dt = min(default_step(model, v) for v in values)
+        dt = min(steps.values())
     if len(values) > 1 and sample is None:
         sample = dt * max(1, math.ceil(duration / dt / 100_000))
+    _check_work(model, [dt or steps[v] for v in values], duration, dt, sample, allow_long)
     results = []
     with _progress(sys.stderr.isatty() and not as_json) as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -167,8 +199,8 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
             results.append(simulate(model, thrust=v, duration=duration, integrator=integrator.lower(), dt=dt,
                                     perturbation=pert, sample=sample, tol=tol, critical_thrust=crit,
                                     progress=lambda f, task=task: bar.update(task, completed=f)))
-    for w in {str(w.message) for w in caught}:
-        click.echo(f"impstab: warning: {w}", err=True)
+    for w in dict.fromkeys(str(w.message) for w in caught):
+        click.echo(f"impstab: warning: {printable(w)}", err=True)
     _write(results, out)
     png = out.with_suffix(".png")
     _save_png(results, png)
@@ -181,7 +213,7 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     con = Console(highlight=False, width=None if sys.stdout.isatty() else 160)
     con.print(_table(results, model.name))
     con.print(f"critical thrust {crit:.8g} N" if crit is not None else "no critical thrust up to thrust_max")
-    con.print(f"wrote {out} and {png}")
+    con.print(f"wrote {user_text(out)} and {user_text(png)}")
 
 
 commands = [simulate_cmd]

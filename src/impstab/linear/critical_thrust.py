@@ -12,7 +12,7 @@ from ..model.model import DOF_NAMES, Model
 from .critical import CriticalLoad, Crossing, critical_load_family
 from .linearize import ModelFamily
 
-__all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD"]
+__all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD", "operating_point_warnings"]
 
 #: share of kinetic energy above which a dof is listed among the modes involved
 PARTICIPATION_THRESHOLD = 0.05
@@ -117,6 +117,20 @@ class CriticalThrust:
         return json.dumps(jsonable(self.to_dict()))
 
 
+def operating_point_warnings(critical: float | None, operating: float | None, thrust_max: float) -> tuple[str, ...]:
+    """What a critical-thrust result must say about the operating point: that the model is
+    unstable there, or that the search did not reach it."""
+    if operating is None:
+        return ()
+    if critical is not None and critical < operating:
+        return (f"the model is unstable at its operating thrust {operating:g} N: stability is lost at "
+                f"{critical:.6g} N (margin {critical / operating:.4g})",)
+    if critical is None and thrust_max < operating:
+        return (f"the search ends at {thrust_max:g} N, below the operating thrust {operating:g} N: "
+                "stability at the operating point is not established",)
+    return ()
+
+
 def _modes(part: NDArray[np.float64] | None) -> tuple[str, ...]:
     if part is None:
         return ()
@@ -172,6 +186,7 @@ def critical_thrust(
         )
     else:
         und = res
+    notes = operating_point_warnings(res.load, model.thrust.operating, t_max)
     return CriticalThrust(
         thrust=res.load,
         kind=res.kind,
@@ -190,5 +205,5 @@ def critical_thrust(
         fluid_frequency_hz=f_fluid if model.fluid.compressible else None,
         fluid_iterations=iterations,
         fluid_change=change,
-        warnings=tuple(res.warnings) + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
+        warnings=notes + tuple(res.warnings) + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
     )
