@@ -134,8 +134,7 @@ def run_guarded(command: click.Command, argv: list[str] | None) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                # outside standalone mode click returns ctx.exit(n)'s code instead of raising it
-                code = int(command.main(args=argv, prog_name="impstab", standalone_mode=False) or 0)
+                code = _invoke(command, argv)
             except ModelError as exc:
                 code = 2
                 _say("error", exc)
@@ -167,8 +166,12 @@ def run_guarded(command: click.Command, argv: list[str] | None) -> int:
                 where = f"{exc.filename}: " if exc.filename is not None else ""
                 _say("error", f"{where}{exc.strerror or type(exc).__name__}")
             except Exception as exc:  # noqa: BLE001 - last line of defence: no traceback for users
-                code = 1
-                _say("internal error", f"{type(exc).__name__}: {exc}")
+                if isinstance(exc, ValueError) and "null" in str(exc):  # "embedded null byte": a path with NUL
+                    code = 2
+                    _say("error", "a path or argument contains a NUL character")
+                else:
+                    code = 1
+                    _say("internal error", f"{type(exc).__name__}: {exc}")
     except BrokenPipeError:
         _silence_stdout()
         return 1
@@ -177,6 +180,15 @@ def run_guarded(command: click.Command, argv: list[str] | None) -> int:
             _say("warning", line)
     _flush()
     return code
+
+
+def _invoke(command: click.Command, argv: list[str] | None) -> int:
+    """Parse and run ``command`` (``command.main`` without its own handling of Ctrl-C, which
+    prints an empty line before the one that reports it)."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    with command.make_context("impstab", args) as ctx:
+        command.invoke(ctx)
+    return 0
 
 
 def _flush() -> None:

@@ -158,7 +158,16 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
     if output is not None and Path(output).suffix.lower() not in (".nc", ".png"):
         raise ModelError("--output", output, "must end in .nc (netCDF; a PNG is written beside it) or .png")
     model = _load(model_file)
-    res = locus(model, steps=steps, thrust_max=thrust_max, linearization=linearization)
+    try:
+        res = locus(model, steps=steps, thrust_max=thrust_max, linearization=linearization)
+    except ModelError as exc:
+        if exc.field != "thrust_max":
+            raise
+        raise ModelError("--thrust-max" if thrust_max is not None else "analysis.thrust_max", exc.value, exc.rule) from None
+    wanted = thrust_max if thrust_max is not None else model.analysis.thrust_max
+    if res.thrust[-1] < wanted:
+        click.echo(f"impstab: warning: the locus ends at {res.thrust[-1]:.6g} N: no static equilibrium is found "
+                   f"beyond it (the mounts do not carry the thrust up to {wanted:g} N)", err=True)
     crit = critical_thrust(model, thrust_max=res.thrust[-1], linearization=linearization)
     from dataclasses import replace
 

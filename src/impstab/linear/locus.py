@@ -131,6 +131,14 @@ def locus(
         raise ModelError("thrusts", thrusts.tolist(), "must be a 1-D list of finite numbers")
     fam = ModelFamily(model, linearization)
     m, d, g, k = fam.matrices(thrusts)
+    # the family has no matrices (NaN) where no static equilibrium exists: the locus ends there
+    finite = np.isfinite(k).all(axis=(-2, -1)) & np.isfinite(m).all(axis=(-2, -1)) & np.isfinite(d + g).all(axis=(-2, -1))
+    if not finite.all():
+        end = int(np.argmin(finite))
+        if end < 2:
+            raise ModelError("thrust_max", float(thrusts[-1]), f"no static equilibrium is found from {thrusts[end]:g} N "
+                             "on: the mounts do not carry the thrust (a locus needs two thrusts)")
+        thrusts, m, d, g, k = thrusts[:end], m[:end], d[:end], g[:end], k[:end]
     vals, vecs = np.linalg.eig(state_matrices(m, d + g, k))
     vals, vecs = track_modes(vals, vecs)
     return LocusResult(thrusts, vals, fam.linearization, model.name, None, model.thrust.operating)  # type: ignore[arg-type]

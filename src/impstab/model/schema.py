@@ -173,7 +173,7 @@ class AnalysisSpec(_Strict):
 class ModelFile(_Strict):
     """The whole model file."""
 
-    schema_version: Integer
+    schema_version: Annotated[Integer, Field(json_schema_extra={"minimum": 1, "maximum": 1})]
     name: Optional[Text] = None
     body: BodySpec
     hull: Optional[HullSpec] = None
