@@ -131,8 +131,9 @@ def run_guarded(command: click.Command, argv: list[str] | None) -> int:
     caught: list = []
     code = 1
     try:
+        # record what the warning filters let through (numpy's floating-point warnings among them);
+        # filters set by impstab or its libraries still apply
         with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
             try:
                 code = _invoke(command, argv)
             except ModelError as exc:

@@ -30,9 +30,10 @@ low, high}``.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Optional, Union
+from typing import Annotated, Any, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr, field_validator
+from pydantic import (BaseModel, ConfigDict, Discriminator, Field, StrictBool, StrictFloat, StrictInt, StrictStr, Tag,
+                      field_validator)
 
 from ..limits import MAX_TEXT
 from ..model.schema import Finite, Integer, Positive, Text, integer
@@ -85,9 +86,24 @@ class DistributionSpec(_Strict):
     sigma: Optional[Positive] = None
 
 
+#: labels of the two shapes of ``values`` (left out of the field names in messages)
+VALUES_TAGS = ("range", "value list")
+
+
+def _values_shape(value: Any) -> str:
+    return "range" if isinstance(value, (dict, RangeSpec)) else "value list"
+
+
+ValuesSpec = Annotated[
+    Union[Annotated[RangeSpec, Tag("range")],
+          Annotated[list[Scalar], Field(min_length=1, max_length=MAX_VALUES), Tag("value list")]],
+    Discriminator(_values_shape),
+]
+
+
 class ParameterSpec(_Strict):
     path: Text
-    values: Optional[Union[RangeSpec, Annotated[list[Scalar], Field(min_length=1, max_length=MAX_VALUES)]]] = None
+    values: Optional[ValuesSpec] = None
     distribution: Optional[DistributionSpec] = None
 
 

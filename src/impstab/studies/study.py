@@ -25,7 +25,7 @@ from ..limits import MAX_STUDY_BYTES
 from ..model.assemble import _plain_loc, check_nesting, format_location, model_from_dict, parse_toml, read_text, rule_text
 from .paths import ParameterPath, resolve_path
 from .sampling import axis_values, check_distribution, map_samples, unit_samples
-from .schema import ParameterSpec, RangeSpec, StudyFile
+from .schema import VALUES_TAGS, ParameterSpec, RangeSpec, StudyFile
 
 __all__ = ["Study", "Parameter", "load_study", "study_from_dict", "describe", "MAX_DESIGNS", "result_bytes"]
 
@@ -100,7 +100,7 @@ def _shown(value: Any) -> Any:
 
 def _schema_error(err: ValidationError) -> ModelError:
     first = err.errors()[0]
-    loc = tuple(p for p in _plain_loc(first["loc"]) if not (isinstance(p, str) and "[" in p))
+    loc = tuple(p for p in _plain_loc(first["loc"]) if not (isinstance(p, str) and ("[" in p or p in VALUES_TAGS)))
     field = format_location(loc)
     kind = first["type"]
     if kind == "extra_forbidden":
@@ -134,6 +134,26 @@ def _checked(par: ParameterPath, values: list, field: str) -> NDArray:
     return np.asarray(out, dtype=dtype)
 
 
+def _checked_array(par: ParameterPath, values: NDArray, field: str) -> NDArray:
+    """A generated column (a range, samples of a distribution) checked with the field's rule.
+
+    The rule of a numeric field is a range, so the smallest and the largest value decide; a
+    non-finite value (an infinite quantile) is reported first.
+    """
+    arr = np.asarray(values)
+    if arr.size == 0:
+        return arr
+    if arr.dtype.kind == "f" and not np.isfinite(arr).all():
+        bad = arr[~np.isfinite(arr)][0]
+        raise ModelError(field, float(bad), f"must be a finite number (the rule of {par.path})")
+    for v in (arr.min(), arr.max()):
+        try:
+            par.check(v.item())
+        except ValueError as exc:
+            raise ModelError(field, v.item(), f"{exc} (the rule of {par.path})") from None
+    return arr.astype(np.int64 if par.kind == "int" else np.float64)
+
+
 def _grid_axis(spec: ParameterSpec, par: ParameterPath, i: int) -> NDArray:
     f = f"parameters[{i}]"
     if spec.distribution is not None:
@@ -146,14 +166,17 @@ def _grid_axis(spec: ParameterSpec, par: ParameterPath, i: int) -> NDArray:
         axis = axis_values(spec)
     except ValueError as exc:
         raise ModelError(f"{f}.values", _shown(spec.values), str(exc)) from None
-    if par.kind == "int" and isinstance(spec.values, RangeSpec):
-        rounded = np.round(axis)
-        if not np.allclose(axis, rounded, rtol=0, atol=1e-9 * max(1.0, np.abs(axis).max())):
-            raise ModelError(f"{f}.values", _shown(spec.values), f"{par.path} is an integer: the range must hit integers (or give a list)")
-        axis = rounded.astype(np.int64).tolist()
-    elif isinstance(axis, np.ndarray):
-        axis = axis.tolist()
-    values = _checked(par, axis, f"{f}.values")
+    if isinstance(spec.values, RangeSpec):
+        if par.kind not in ("float", "int"):
+            raise ModelError(f"{f}.values", _shown(spec.values), f"{par.path} is not a number: give a list of values")
+        if par.kind == "int":
+            rounded = np.round(axis)
+            if not np.allclose(axis, rounded, rtol=0, atol=1e-9 * max(1.0, np.abs(axis).max())):
+                raise ModelError(f"{f}.values", _shown(spec.values), f"{par.path} is an integer: the range must hit integers (or give a list)")
+            axis = rounded.astype(np.int64)
+        values = _checked_array(par, axis, f"{f}.values")
+    else:
+        values = _checked(par, axis, f"{f}.values")
     if len(np.unique(values)) != len(values):
         raise ModelError(f"{f}.values", axis if len(axis) < 12 else f"{len(axis)} values", "must be distinct")
     return values
@@ -167,8 +190,8 @@ def _sample_column(spec: ParameterSpec, par: ParameterPath, i: int, u: NDArray) 
         key = "distribution" if spec.distribution is not None else "values"
         raise ModelError(f"{f}.{key}", _shown(getattr(spec, key)), str(exc)) from None
     if isinstance(spec.values, list):
-        _checked(par, spec.values, f"{f}.values")
-        return _checked(par, map_samples(spec, u), f"{f}.values")
+        dtype = _checked(par, spec.values, f"{f}.values").dtype
+        return np.asarray(map_samples(spec, u), dtype=dtype)
     if par.kind != "float":
         raise ModelError(f"{f}.values", par.kind, f"{par.path} is not a real number: give a list of values to draw from")
     ends = []
@@ -176,8 +199,9 @@ def _sample_column(spec: ParameterSpec, par: ParameterPath, i: int, u: NDArray) 
         ends = [spec.values.start, spec.values.stop]
     elif spec.distribution.low is not None:
         ends = [spec.distribution.low, spec.distribution.high]
-    _checked(par, ends, f"{f}.{'values' if spec.values is not None else 'distribution'}")
-    return np.asarray(map_samples(spec, u), dtype=np.float64)
+    key = f"{f}.{'values' if spec.values is not None else 'distribution'}"
+    _checked(par, ends, key)
+    return _checked_array(par, np.asarray(map_samples(spec, u), dtype=np.float64), key)
 
 
 def study_from_dict(
