@@ -221,3 +221,20 @@ def test_unknown_key_with_escape_sequences_is_shown_escaped():
         model_from_dict(d)
     assert "\x1b" not in str(info.value) and "\\x1b[2Jmass" in str(info.value)
     json.dumps(str(info.value))
+
+
+def test_the_documented_ranges_are_the_enforced_ones():
+    from pathlib import Path
+
+    from impstab import limits
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "limits.md").read_text()
+    for name, r in RANGES.items():
+        row = f"| `{name}` | {r.what} | {r.low:g} | {r.high:g} | {r.unit or '-'} |"
+        assert row in text, row
+    for needle in (f"{limits.MAX_FILE_BYTES // 1024**2} MiB", f"{limits.MAX_NESTING} levels", f"{limits.MAX_QUADRATURE_NODES:.0e}".replace("+0", ""),
+                   "10 000 frequencies", f"{limits.MAX_STEPS:.0e}".replace("+0", "") + " steps", "1 GiB", "| 100 |",
+                   "| 100 000 |", "2 GiB", f"factor of {limits.LONG_FACTOR}"):
+        assert needle in text, needle
+    assert limits.MAX_FREQUENCIES == 10_000 and limits.MAX_OUTPUT_BYTES == 1024**3 and limits.MAX_THRUSTS == 100
+    assert limits.MAX_LOCUS_STEPS == 100_000 and limits.MAX_STUDY_BYTES == 2 * 1024**3 and limits.MAX_SWEEP_NODES == 10**8
