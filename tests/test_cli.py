@@ -272,3 +272,17 @@ def test_a_closed_pipe_is_quiet(examples):
     proc = subprocess.run(f"{sys.executable} -m impstab critical {examples / 'imp_symmetric.toml'} | head -c 1",
                           shell=True, capture_output=True, text=True, timeout=120)
     assert proc.stderr == ""
+
+
+def test_outputs_never_replace_a_pipe_or_a_device(capsys, examples, tmp_path):
+    import stat
+
+    ex = str(examples / "imp_symmetric.toml")
+    for name in ("l.nc", "s.nc", "a.png", "s.png"):
+        os.mkfifo(tmp_path / name)
+    one_line_error(capsys, "locus", ex, "--steps", "4", "-o", str(tmp_path / "l.nc"), field="--output")
+    one_line_error(capsys, "simulate", ex, "--thrust", "100", "--duration", "0.1", "-o", str(tmp_path / "s.nc"),
+                   field="--output")
+    one_line_error(capsys, "added-mass", "--radius", "0.1", "--length", "1", "--frequencies", "0:1:2", "-o",
+                   str(tmp_path / "a.png"), field="--output")
+    assert all(stat.S_ISFIFO((tmp_path / n).stat().st_mode) for n in ("l.nc", "s.nc", "a.png", "s.png"))

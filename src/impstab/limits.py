@@ -23,7 +23,7 @@ from .errors import ModelError
 __all__ = [
     "Range", "RANGES", "as_number", "as_integer", "as_boolean", "check_number", "check_integer",
     "refuse_work",
-    "MAX_FILE_BYTES", "MAX_NESTING", "MAX_TEXT", "MAX_MOUNTS", "MAX_QUADRATURE_NODES",
+    "MAX_FILE_BYTES", "MAX_NESTING", "MAX_LIST_ITEMS", "MAX_TEXT", "MAX_MOUNTS", "MAX_QUADRATURE_NODES",
     "MAX_SWEEP_NODES", "MAX_FREQUENCIES", "MAX_STEPS", "MAX_OUTPUT_BYTES", "MAX_THRUSTS",
     "MAX_LOCUS_STEPS", "MAX_STUDY_BYTES", "LONG_FACTOR", "MIN_DIRECTION",
 ]
@@ -170,6 +170,8 @@ MIN_DIRECTION = 1e-6
 MAX_FILE_BYTES = 4 * 1024 * 1024
 #: deepest nesting of tables and arrays in a model or study file (a model needs 5)
 MAX_NESTING = 32
+#: most items of one array in a model file (a study's list of values may hold more)
+MAX_LIST_ITEMS = 100_000
 #: longest string value (a name, a path), in characters
 MAX_TEXT = 4096
 #: most mounts in one model (mounts plus every ring's count)

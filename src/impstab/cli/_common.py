@@ -12,7 +12,7 @@ import click
 
 from ..errors import ModelError, NumericalError, printable
 
-__all__ = ["run_guarded", "print_json", "jsonable", "BadInput", "console", "check_number", "user_text", "at_thrust"]
+__all__ = ["run_guarded", "print_json", "jsonable", "BadInput", "console", "check_number", "user_text", "at_thrust", "check_output"]
 
 
 class BadInput(click.ClickException):
@@ -84,6 +84,28 @@ def at_thrust(option: str, thrust: float, model, compute):
                                              f"at {crit.thrust:.6g} N ({crit.kind}) and its mounts do not carry "
                                              "this thrust") from None
         raise
+
+
+def check_output(option: str, path: object) -> None:
+    """An output path must be a new file or a regular file: a FIFO, a device, a socket or a
+    folder of that name would be replaced by the rename that writes the output."""
+    import os
+    import stat
+
+    try:
+        mode = os.lstat(os.fspath(path)).st_mode  # type: ignore[arg-type]
+    except FileNotFoundError:
+        return
+    except (OSError, ValueError):
+        return  # unreadable parent or odd name: the write itself reports it with the path
+    if stat.S_ISLNK(mode):
+        try:
+            mode = os.stat(os.fspath(path)).st_mode  # type: ignore[arg-type]
+        except OSError:
+            return
+    if not stat.S_ISREG(mode):
+        kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file (a pipe, a device or a socket)"
+        raise ModelError(option, str(path), f"exists and is {kind}: give the name of a file to write")
 
 
 def user_text(value: object) -> str:

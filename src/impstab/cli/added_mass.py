@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..limits import LONG_FACTOR, MAX_FREQUENCIES, MAX_SWEEP_NODES, RANGES, describe_count
-from ._common import console, print_json
+from ._common import check_output, console, print_json
 
 __all__ = ["commands", "parse_frequencies"]
 
@@ -145,6 +145,8 @@ def added_mass_cmd(radius: float, length: float, density: float, sound_speed: fl
         raise ModelError("--frequencies", frequencies, "give either --frequency or --frequencies, not both")
     if output is not None and not output.lower().endswith(".png"):
         raise ModelError("--output", output, "must be a .png file")
+    if output is not None:
+        check_output("--output", output)
     grid = parse_frequencies(frequencies, MAX_FREQUENCIES * (LONG_FACTOR if allow_long else 1))
     # validate the geometry and the work before a long sweep starts
     _with_flag_names(fluid.baffled_cylinder, radius, length, density, sound_speed, 0.0)

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..limits import MAX_LOCUS_STEPS
-from ._common import at_thrust, check_number, console, print_json, user_text
+from ._common import at_thrust, check_number, check_output, console, print_json, user_text
 
 __all__ = ["commands"]
 
@@ -174,6 +174,8 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
     res = replace(res, critical_thrust=crit.thrust)
     out = Path(output) if output else Path(Path(model_file).stem + "-locus.nc")
     png = out.with_suffix(".png")
+    check_output("--output", out)
+    check_output("--output", png)
     if out.suffix.lower() == ".nc":
         with atomic_path(out) as tmp:
             res.to_xarray().to_netcdf(tmp, engine="h5netcdf")

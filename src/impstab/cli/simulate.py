@@ -11,7 +11,7 @@ import click
 
 from ..errors import ModelError, printable
 from ..limits import LONG_FACTOR, MAX_OUTPUT_BYTES, MAX_STEPS, MAX_THRUSTS, describe_count
-from ._common import at_thrust, check_number, print_json, user_text
+from ._common import at_thrust, check_number, check_output, print_json, user_text
 
 __all__ = ["commands"]
 
@@ -179,6 +179,8 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     out = Path(output) if output else Path(Path(model_file).stem + "-simulation.nc")
     if out.suffix.lower() not in (".nc", ".csv"):
         raise ModelError("--output", output, "must end in .nc (netCDF) or .csv; a PNG is written beside it")
+    check_output("--output", out)
+    check_output("--output", out.with_suffix(".png"))
     pert = None
     if displace or kick:
         pert = {"displacement": _dof_values("--displace", displace), "velocity": _dof_values("--kick", kick)}

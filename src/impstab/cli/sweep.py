@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from ..errors import ModelError, printable
-from ._common import console, user_text
+from ._common import check_output, console, user_text
 
 __all__ = ["commands"]
 
@@ -51,6 +51,7 @@ def sweep_cmd(study_file: str, store: str | None, workers: int | None, scheduler
     for path in exports:
         if Path(path).suffix.lower() not in _EXPORTS:
             raise ModelError("--export", path, "must end in .nc (netCDF) or .csv")
+        check_output("--export", path)
     study = load_study(study_file)
     out = Path(store) if store else Path(Path(study_file).stem + ".zarr")
     if progress is None:
@@ -131,6 +132,7 @@ def map_cmd(store: str, x: str | None, y: str | None, value: str, at: tuple[str,
     out = Path(output) if output else Path(str(Path(store)).rstrip("/\\").removesuffix(".zarr") + "-map.png")
     if out.suffix.lower() != ".png":
         raise ModelError("--output", str(out), "must end in .png")
+    check_output("--output", out)
     res = open_study(store)
     import matplotlib
 

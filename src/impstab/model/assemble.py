@@ -15,7 +15,7 @@ import numpy as np
 from pydantic import ValidationError
 
 from ..errors import ModelError
-from ..limits import MAX_FILE_BYTES, MAX_MOUNTS, MAX_NESTING, MIN_DIRECTION, RANGES
+from ..limits import MAX_FILE_BYTES, MAX_LIST_ITEMS, MAX_MOUNTS, MAX_NESTING, MIN_DIRECTION, RANGES
 from .body import RigidBody
 from .fluid import FluidLoading, Hull
 from .model import AnalysisSettings, Model
@@ -268,8 +268,9 @@ def model_from_dict(data: dict, name: str | None = None, source: str | None = No
     return _assemble(doc, doc.name or name or "model", source)
 
 
-def check_nesting(data: Any, limit: int = MAX_NESTING) -> None:
-    """ModelError when tables and arrays nest deeper than ``limit`` (checked without recursion)."""
+def check_nesting(data: Any, limit: int = MAX_NESTING, max_items: int | None = MAX_LIST_ITEMS) -> None:
+    """ModelError when tables and arrays nest deeper than ``limit``, or an array holds more than
+    ``max_items`` values (checked without recursion, before the schema sees the data)."""
     stack: list[tuple[Any, int, tuple]] = [(data, 0, ())]
     while stack:
         value, depth, loc = stack.pop()
@@ -277,9 +278,15 @@ def check_nesting(data: Any, limit: int = MAX_NESTING) -> None:
             raise ModelError(format_location(loc[:2]), _lookup(data, loc[:2]),
                              f"tables and arrays may nest at most {limit} levels deep")
         if isinstance(value, dict):
-            stack.extend((v, depth + 1, loc + (str(k),)) for k, v in value.items())
-        elif isinstance(value, list):
-            stack.extend((v, depth + 1, loc + (i,)) for i, v in enumerate(value))
+            items = value.items()
+        else:
+            if max_items is not None and len(value) > max_items:
+                raise ModelError(format_location(loc) if loc else "(file)", f"{len(value)} items",
+                                 f"an array may hold at most {max_items} items")
+            items = enumerate(value)
+        for key, item in items:
+            if isinstance(item, (dict, list)):
+                stack.append((item, depth + 1, loc + (key,)))
 
 
 def read_text(path: str | os.PathLike[str], what: str = "model file") -> str:
@@ -331,7 +338,7 @@ def read_text(path: str | os.PathLike[str], what: str = "model file") -> str:
         raise ModelError(what, str(p), f"is not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset {exc.start})") from None
 
 
-def parse_toml(text: str, path: str | os.PathLike[str], what: str = "model file") -> dict:
+def parse_toml(text: str, path: str | os.PathLike[str], what: str = "model file", max_items: int | None = MAX_LIST_ITEMS) -> dict:
     """Parse TOML text, turning a syntax error or too deep a nesting into a one-line ModelError."""
     try:
         data = tomllib.loads(text)
@@ -339,7 +346,7 @@ def parse_toml(text: str, path: str | os.PathLike[str], what: str = "model file"
         raise ModelError(what, str(path), f"is not valid TOML ({exc})") from None
     except RecursionError:
         raise ModelError(what, str(path), f"is nested too deeply (tables and arrays at most {MAX_NESTING} levels)") from None
-    check_nesting(data)
+    check_nesting(data, max_items=max_items)
     return data
 
 

@@ -220,7 +220,7 @@ def study_from_dict(
     """
     if not isinstance(data, dict):
         raise ModelError("(study file)", type(data).__name__, "must be a table of study keys")
-    check_nesting(data)
+    check_nesting(data, max_items=None)
     if "schema_version" not in data:
         raise ModelError("schema_version", None, "is required (schema_version = 1)")
     try:
@@ -297,7 +297,7 @@ def load_study(path: str | os.PathLike[str]) -> Study:
     """
     p = Path(path)
     text = read_text(p, "study file")
-    data = parse_toml(text, p, "study file")
+    data = parse_toml(text, p, "study file", max_items=None)
     return study_from_dict(data, p.parent, source=str(p), text=text)
 
 
