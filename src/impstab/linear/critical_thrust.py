@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from ..limits import check_number
 from ..model.model import DOF_NAMES, Model
 from .critical import CriticalLoad, Crossing, critical_load_family
 from .linearize import ModelFamily
@@ -163,7 +164,7 @@ def critical_thrust(
     -------
     CriticalThrust
     """
-    t_max = float(thrust_max if thrust_max is not None else model.analysis.thrust_max)
+    t_max = check_number("thrust_max", thrust_max if thrust_max is not None else model.analysis.thrust_max, "thrust")
     search = dict(n_scan=n_scan)
     f_fluid, iterations, change = 0.0, 0, None
     fam = ModelFamily(model, linearization)
