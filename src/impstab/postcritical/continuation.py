@@ -1,0 +1,641 @@
+"""Pseudo-arclength continuation of periodic orbits in the parameter, with bifurcation detection.
+
+From a Hopf point the first cycle solves the collocation equations with the constraint
+``<U - U_H, V_H> = ds``: ``U_H`` is the equilibrium as a constant "cycle" of period ``2 pi / omega``
+and ``V_H = (2 Re(q e^{2 pi i tau}), 0, 0)`` the direction in which the cycles leave it; the
+normal form (radius, parameter and period at that amplitude, second-order shape) is the initial
+guess. Each later step predicts along the unit tangent ``V_k`` and corrects with Newton's method
+under ``<U - U_k, V_k> = ds`` (Keller's pseudo-arclength), so folds are passed without special
+treatment. The step grows after quick convergence, shrinks after slow convergence, a failure or a
+sharp turn of the tangent. The mesh is re-equidistributed every ``adapt_every`` steps (AUTO's IAD)
+and the number of intervals doubled while the estimated profile error exceeds ``mesh_tolerance``.
+
+On every accepted step the test functions are compared with the previous point's and each sign
+change is located by Brent's method in the arclength (each trial point a corrected cycle):
+
+* fold (limit point of cycles): ``dp/ds``, the parameter component of the tangent;
+* period doubling: ``mu + 1`` for the real multiplier closest to -1 (an odd change of the number
+  of real multipliers below -1);
+* torus (Neimark-Sacker): ``|mu| - 1`` for the complex multiplier closest to the unit circle (a
+  change of the number of complex multipliers outside it, the pair staying complex).
+
+Requested parameter values crossed by a step are solved exactly (Newton's method at fixed ``p``
+from the interpolated cycle), and so is the end point at ``p_min`` / ``p_max``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import brentq
+
+from ..errors import ModelError, NumericalError
+from .collocation import Profile
+from .floquet import FloquetMultipliers
+from .hopf import HopfPoint
+from .mesh import equidistribute, error_indicator
+from .periodic import OrbitProblem, Solution, Weights
+from .result import Cycle, CycleBranch, SpecialPoint
+from .system import DynamicalSystem, as_system
+
+__all__ = ["continue_cycles", "find_cycle", "cycle_at", "cycles_at"]
+
+Array = NDArray[np.float64]
+
+#: a step is rejected when the tangent turns by more than this (cosine of the angle)
+MIN_TANGENT_COSINE = 0.9
+#: real multiplier: |Im mu| below this share of max(1, |mu|)
+REAL_MULTIPLIER = 1e-7
+#: stability margin floor (see Cycle.stability_tolerance)
+STABILITY_FLOOR = 1e-9
+#: relative accuracy of the arclength of a located special point
+LOCATE_XTOL = 1e-12
+
+
+@dataclass
+class _Point:
+    sol: Solution
+    problem: OrbitProblem
+    tangent: Array
+    floquet: FloquetMultipliers
+    arclength: float
+    label: str = ""
+
+    @property
+    def u(self) -> Array:
+        return self.sol.vector
+
+    @property
+    def p(self) -> float:
+        return self.sol.parameter
+
+
+class _Tracer:
+    """The working state of one continuation run."""
+
+    def __init__(self, system: DynamicalSystem, weights: Weights, degree: int, mesh_tolerance: float | None,
+                 max_intervals: int) -> None:
+        self.system = system
+        self.weights = weights
+        self.degree = degree
+        self.mesh_tolerance = mesh_tolerance
+        self.max_intervals = max_intervals
+        self.problems: dict[bytes, OrbitProblem] = {}
+        self.failures = 0
+
+    def problem(self, mesh: Array) -> OrbitProblem:
+        key = mesh.tobytes()
+        if key not in self.problems:
+            if len(self.problems) > 8:
+                self.problems.clear()
+            self.problems[key] = OrbitProblem(self.system, mesh, self.degree, self.weights)
+        return self.problems[key]
+
+    def finish(self, prob: OrbitProblem, sol: Solution | None, ref: Profile, orient: Array, s: float,
+               label: str = "") -> _Point | None:
+        if sol is None:
+            self.failures += 1
+            return None
+        try:
+            tangent = prob.tangent(sol, ref, orient)
+            floq = prob.floquet(sol)
+        except (RuntimeError, NumericalError, np.linalg.LinAlgError):
+            self.failures += 1
+            return None
+        if not np.all(np.isfinite(tangent)):
+            return None
+        return _Point(sol, prob, tangent, floq, s, label)
+
+    def correct(self, base: _Point, ds: float, label: str = "") -> _Point | None:
+        prob = base.problem
+        guess = base.u + ds * base.tangent
+        sol = prob.solve(guess, base.sol.profile, ("arclength", base.u, ds, base.tangent))
+        return self.finish(prob, sol, base.sol.profile, base.tangent, base.arclength + ds, label)
+
+    def at_parameter(self, a: _Point, b: _Point, p_star: float, label: str) -> _Point | None:
+        prob = a.problem
+        theta = (p_star - a.p) / (b.p - a.p) if b.p != a.p else 0.5
+        guess = a.u + theta * (b.u - a.u)
+        guess[-1] = p_star
+        sol = prob.solve(guess, a.sol.profile, ("parameter", None, p_star, None))
+        return self.finish(prob, sol, a.sol.profile, a.tangent, a.arclength + theta * (b.arclength - a.arclength),
+                           label)
+
+    def remesh(self, pt: _Point) -> _Point:
+        """The point on an equidistributed mesh (more intervals while the error is too large)."""
+        scale = self.weights.state
+        prof = pt.sol.profile
+        intervals = prof.intervals
+        err = self._relative_error(prof)
+        if self.mesh_tolerance is not None and err > self.mesh_tolerance:
+            intervals = min(2 * intervals, self.max_intervals)
+        new_mesh = equidistribute(prof, scale, intervals)
+        prob = self.problem(new_mesh)
+        new_prof = prof.resample(new_mesh)
+        tan_prof = Profile(prof.mesh, pt.tangent[:-2].reshape(prof.nodes.shape), prof.degree).resample(new_mesh)
+        orient = prob.pack(tan_prof, pt.tangent[-2], pt.tangent[-1])
+        guess = prob.pack(new_prof, pt.sol.period, pt.p)
+        sol = prob.solve(guess, new_prof, ("parameter", None, pt.p, None))
+        new = self.finish(prob, sol, new_prof, orient / max(prob.norm(orient), 1e-300), pt.arclength, pt.label)
+        return pt if new is None else new
+
+    def _relative_error(self, prof: Profile) -> float:
+        err, _ = error_indicator(prof, self.weights.state)
+        amp = float(np.max(prof.amplitude() / self.weights.state))
+        return err / max(amp, 1e-300)
+
+
+def _cycle(pt: _Point, label: str | None = None) -> Cycle:
+    prof = pt.sol.profile
+    lo, hi = prof.extrema()
+    fl = pt.floquet
+    tol = max(STABILITY_FLOOR, 10.0 * fl.trivial_error)
+    stable = fl.largest < 1.0
+    err, _ = error_indicator(prof, pt.problem.weights.state)
+    return Cycle(parameter=pt.p, period=pt.sol.period, profile=prof, multipliers=fl.values, trivial=fl.trivial,
+                 trivial_error=fl.trivial_error, stable=bool(stable), stability_tolerance=tol,
+                 amplitude=0.5 * (hi - lo), minimum=lo, maximum=hi, mean=prof.mean(), mesh_error=err,
+                 arclength=pt.arclength, label=pt.label if label is None else label,
+                 newton_iterations=pt.sol.iterations)
+
+
+# ----------------------------------------------------------------------- test functions
+def _real_below_minus_one(pt: _Point) -> int:
+    nt = pt.floquet.nontrivial
+    real = np.abs(nt.imag) <= REAL_MULTIPLIER * np.maximum(1.0, np.abs(nt))
+    return int(np.sum(real & (nt.real < -1.0)))
+
+
+def _complex_outside(pt: _Point) -> int:
+    nt = pt.floquet.nontrivial
+    cplx = np.abs(nt.imag) > REAL_MULTIPLIER * np.maximum(1.0, np.abs(nt))
+    return int(np.sum(cplx & (np.abs(nt) > 1.0)))
+
+
+def _pd_test(pt: _Point) -> float:
+    nt = pt.floquet.nontrivial
+    real = np.abs(nt.imag) <= REAL_MULTIPLIER * np.maximum(1.0, np.abs(nt))
+    if not np.any(real & (nt.real < 0)):
+        return math.nan
+    cand = nt[real & (nt.real < 0)].real
+    return float(cand[np.argmin(np.abs(cand + 1.0))] + 1.0)
+
+
+def _ns_test(pt: _Point) -> float:
+    nt = pt.floquet.nontrivial
+    cplx = np.abs(nt.imag) > REAL_MULTIPLIER * np.maximum(1.0, np.abs(nt))
+    if not np.any(cplx):
+        return math.nan
+    mod = np.abs(nt[cplx])
+    return float(mod[np.argmin(np.abs(mod - 1.0))] - 1.0)
+
+
+def _fold_test(pt: _Point) -> float:
+    return float(pt.tangent[-1])
+
+
+_TESTS: dict[str, Callable[[_Point], float]] = {"fold": _fold_test, "period-doubling": _pd_test, "torus": _ns_test}
+
+
+def _critical_multiplier(kind: str, pt: _Point) -> complex | None:
+    nt = pt.floquet.nontrivial
+    if kind == "fold":
+        return complex(nt[np.argmin(np.abs(nt - 1.0))]) if nt.size else None
+    if kind == "period-doubling":
+        return complex(nt[np.argmin(np.abs(nt + 1.0))])
+    cplx = nt[np.abs(nt.imag) > 0]
+    return complex(cplx[np.argmin(np.abs(np.abs(cplx) - 1.0))]) if cplx.size else None
+
+
+def _events(a: _Point, b: _Point) -> list[str]:
+    out = []
+    if _fold_test(a) * _fold_test(b) < 0:
+        out.append("fold")
+    if (_real_below_minus_one(a) - _real_below_minus_one(b)) % 2 == 1:
+        ta, tb = _pd_test(a), _pd_test(b)
+        if math.isfinite(ta) and math.isfinite(tb) and ta * tb < 0:
+            out.append("period-doubling")
+    if _complex_outside(a) != _complex_outside(b):
+        ta, tb = _ns_test(a), _ns_test(b)
+        if math.isfinite(ta) and math.isfinite(tb) and ta * tb < 0:
+            out.append("torus")
+    return out
+
+
+def _locate(tracer: _Tracer, a: _Point, b: _Point, kind: str) -> _Point | None:
+    test = _TESTS[kind]
+    ds_total = b.arclength - a.arclength
+    memo: dict[float, _Point] = {}
+
+    def g(s: float) -> float:
+        if s <= 0:
+            return test(a)
+        if s >= ds_total:
+            return test(b)
+        pt = tracer.correct(a, s, kind)
+        if pt is None:
+            raise NumericalError(f"no convergence while locating a {kind}")
+        memo[s] = pt
+        val = test(pt)
+        if not math.isfinite(val):
+            raise NumericalError(f"the {kind} test function is undefined inside its bracket")
+        return val
+
+    try:
+        s_star = brentq(g, 0.0, ds_total, xtol=LOCATE_XTOL * max(1.0, abs(ds_total)), rtol=4 * np.finfo(float).eps,
+                        maxiter=60)
+    except (NumericalError, ValueError, RuntimeError):
+        return None
+    pt = memo.get(s_star) or tracer.correct(a, s_star, kind)
+    if pt is not None:
+        pt.label = kind
+    return pt
+
+
+# ----------------------------------------------------------------------- starting points
+def _settings_weights(system, period_scale, parameter_scale) -> Weights:
+    return Weights(np.asarray(system.state_scale, dtype=float), float(period_scale), float(parameter_scale))
+
+
+def _hopf_start(tracer: _Tracer, hopf: HopfPoint, intervals: int, ds: float) -> _Point:
+    if hopf.onset != "hopf" or hopf.eigenvector is None or not hopf.omega:
+        raise ModelError("hopf", hopf.bifurcation, "cycles start from a Hopf point (a complex pair at onset); "
+                         f"this onset is a {hopf.onset}")
+    if hopf.bifurcation == "degenerate" and hopf.reason and not hopf.reason.startswith("l1 = 0"):
+        raise ModelError("hopf", hopf.reason, "the branch of a single pair does not describe this onset; give a "
+                         "start cycle (find_cycle) for a chosen branch")
+    mesh = np.linspace(0.0, 1.0, intervals + 1)
+    prob = tracer.problem(mesh)
+    q = hopf.eigenvector
+    period0 = 2 * math.pi / hopf.omega
+    direction = Profile.uniform(lambda t: 2 * np.real(np.exp(2j * np.pi * t)[:, None] * q[None, :]),
+                                intervals, tracer.degree)
+    base = Profile(mesh, np.tile(hopf.state, (direction.nodes.shape[0], 1)), tracer.degree)
+    u_h = prob.pack(base, period0, hopf.parameter)
+    v_raw = prob.pack(direction, 0.0, 0.0)
+    v_h = v_raw / prob.norm(v_raw)
+    rho = ds / prob.norm(v_raw)
+    if hopf.bifurcation != "degenerate":
+        c1 = hopf.normal_form_coefficient
+        p1 = hopf.parameter - c1.real * rho ** 2 / hopf.crossing_speed
+        z = lambda t: rho * np.exp(2j * np.pi * t)                                   # noqa: E731
+        guess_prof = Profile.uniform(
+            lambda t: (hopf.state + hopf.equilibrium_slope * (p1 - hopf.parameter))[None, :]
+            + 2 * np.real(z(t)[:, None] * q[None, :]) + np.real(z(t)[:, None] ** 2 * hopf.h20[None, :])
+            + rho ** 2 * hopf.h11[None, :], intervals, tracer.degree)
+        guess = prob.pack(guess_prof, float(hopf.predicted_period(p1)), p1)
+    else:
+        guess = u_h + ds * v_h
+    ref = prob.profile(u_h + ds * v_h)
+    sol = prob.solve(guess, ref, ("arclength", u_h, ds, v_h))
+    pt = tracer.finish(prob, sol, ref, v_h, ds, "start")
+    if pt is None:
+        raise NumericalError(f"no cycle converged at the first step from the Hopf point (ds = {ds:g}); try a smaller ds")
+    return pt
+
+
+def _cycle_start(tracer: _Tracer, cycle: Cycle, direction: int) -> _Point:
+    prof = cycle.profile
+    prob = tracer.problem(prof.mesh)
+    guess = prob.pack(prof, cycle.period, cycle.parameter)
+    sol = prob.solve(guess, prof, ("parameter", None, cycle.parameter, None))
+    orient = np.zeros(prob.size)
+    orient[-1] = float(direction)
+    pt = tracer.finish(prob, sol, prof, orient / prob.norm(orient), 0.0, "start")
+    if pt is None:
+        raise NumericalError("the start cycle did not converge at its parameter value")
+    return pt
+
+
+# ----------------------------------------------------------------------- public API
+def continue_cycles(
+    f,
+    start: HopfPoint | Cycle,
+    p_max: float,
+    *,
+    p_min: float = -math.inf,
+    parameters: tuple[float, ...] | list[float] = (),
+    amplitude_max: float = math.inf,
+    period_max: float = math.inf,
+    max_points: int = 200,
+    ds: float = 0.01,
+    ds_min: float = 1e-7,
+    ds_max: float = 0.2,
+    intervals: int = 40,
+    degree: int = 4,
+    adapt_every: int = 3,
+    mesh_tolerance: float | None = 1e-7,
+    max_intervals: int = 320,
+    period_scale: float | None = None,
+    parameter_scale: float = 1.0,
+    direction: int = 1,
+    progress: Callable[[int, float], None] | None = None,
+) -> CycleBranch:
+    """Continue the periodic orbits of ``B x' = f(x, p)`` from a Hopf point (or a cycle).
+
+    Parameters
+    ----------
+    f : DynamicalSystem or callable
+        The same system as given to :func:`hopf_analysis`.
+    start : HopfPoint or Cycle
+        The Hopf point the cycles are born at (not a degenerate one, except ``l1 = 0``), or a
+        converged cycle (:func:`find_cycle`) to continue from.
+    p_max, p_min : float
+        The branch ends where it leaves ``[p_min, p_max]``, with a cycle exactly at the bound.
+    parameters : sequence of float
+        Parameter values at which the branch must hold a cycle: every crossing of each value is
+        solved exactly (label "requested"); values never crossed are listed in ``unreached``.
+    amplitude_max, period_max : float
+        Stop when the largest scaled amplitude ``max_j amplitude_j / state_scale_j`` or the period
+        exceeds these (the approach to a homoclinic orbit shows as a growing period).
+    max_points : int
+        Regular continuation steps at most.
+    ds, ds_min, ds_max : float
+        Initial, smallest and largest pseudo-arclength step, in the weighted norm
+        ``|U|^2 = int |x / state_scale|^2 dtau + (T / period_scale)^2 + (p / parameter_scale)^2``.
+        From a Hopf point ``ds`` is also the size of the first cycle in that norm.
+    intervals, degree : int
+        Mesh intervals (AUTO's NTST) and collocation degree (NCOL, Gauss points per interval).
+    adapt_every : int
+        Re-equidistribute the mesh every so many steps (0: fixed mesh).
+    mesh_tolerance : float or None
+        Largest estimated profile error, relative to the largest scaled amplitude, before the
+        number of intervals is doubled (up to ``max_intervals``); None keeps ``intervals``.
+    period_scale : float, optional
+        Period scale of the norm (default: the period at the start).
+    parameter_scale : float
+        Parameter scale of the norm (parameter units).
+    direction : {1, -1}
+        From a start cycle: continue toward increasing (1) or decreasing (-1) ``p``.
+    progress : callable, optional
+        Called as ``progress(points_done, p)`` after every accepted step.
+
+    Returns
+    -------
+    CycleBranch
+    """
+    if isinstance(start, HopfPoint):
+        n = start.state.size
+    elif isinstance(start, Cycle):
+        n = start.profile.nodes.shape[1]
+    else:
+        raise ModelError("start", type(start).__name__, "must be a HopfPoint or a Cycle")
+    system = as_system(f, n)
+    _check_positive("ds", ds)
+    _check_positive("ds_min", ds_min)
+    _check_positive("ds_max", ds_max)
+    _check_positive("parameter_scale", parameter_scale)
+    if not ds_min <= ds <= ds_max:
+        raise ModelError("ds", ds, f"must lie between ds_min = {ds_min:g} and ds_max = {ds_max:g}")
+    if not (p_min < p_max) or math.isnan(p_max):
+        raise ModelError("p_max", p_max, f"must exceed p_min = {p_min:g}")
+    if isinstance(intervals, bool) or int(intervals) != intervals or intervals < 4:
+        raise ModelError("intervals", intervals, "must be an integer of at least 4")
+    if max_intervals < intervals:
+        raise ModelError("max_intervals", max_intervals, f"must be at least intervals = {intervals}")
+    if direction not in (1, -1):
+        raise ModelError("direction", direction, "must be 1 or -1")
+    requested = sorted({float(v) for v in parameters})
+    for v in requested:
+        if not math.isfinite(v):
+            raise ModelError("parameters", v, "must be finite numbers")
+    t0 = (2 * math.pi / start.omega) if isinstance(start, HopfPoint) and start.omega else getattr(start, "period", 1.0)
+    weights = _settings_weights(system, period_scale or t0, parameter_scale)
+    tracer = _Tracer(system, weights, degree, mesh_tolerance, int(max_intervals))
+    if isinstance(start, HopfPoint):
+        first = _hopf_start(tracer, start, int(intervals), ds)
+        hopf = start
+    else:
+        first = _cycle_start(tracer, start, direction)
+        hopf = None
+    if adapt_every:
+        first = tracer.remesh(first)
+    points: list[_Point] = [first]
+    extra: list[_Point] = []
+    special: list[tuple[str, _Point]] = []
+    crossed: set[float] = set()
+    warnings: list[str] = []
+    amp0 = _scaled_amplitude(first)
+    step = ds
+    steps = 0
+    stop = "maximum number of points reached"
+    current = first
+    if not p_min <= current.p <= p_max:
+        stop = "the start lies outside [p_min, p_max]"
+        steps = max_points
+    while steps < max_points:
+        new = tracer.correct(current, step)
+        if new is not None:
+            cos = current.problem.inner(new.tangent, current.tangent)
+            if cos < MIN_TANGENT_COSINE and step > ds_min * 1.0001:
+                new = None
+        if new is None:
+            step *= 0.5
+            if step < ds_min:
+                stop = f"no convergence at the smallest step ds_min = {ds_min:g}"
+                break
+            continue
+        steps += 1
+        # events between current and new
+        for kind in _events(current, new):
+            loc = _locate(tracer, current, new, kind)
+            if loc is None:
+                warnings.append(f"a {kind} between p = {current.p:.10g} and {new.p:.10g} could not be located")
+                continue
+            special.append((kind, loc))
+            extra.append(loc)
+        for v in requested:
+            if (current.p - v) * (new.p - v) < 0 or new.p == v:
+                pt = new if new.p == v else tracer.at_parameter(current, new, v, "requested")
+                if pt is None:
+                    warnings.append(f"no cycle converged at the requested p = {v:.10g}")
+                    continue
+                if pt is new:
+                    new.label = "requested"
+                else:
+                    extra.append(pt)
+                crossed.add(v)
+        leaving = new.p > p_max or new.p < p_min
+        if leaving:
+            bound = p_max if new.p > p_max else p_min
+            end = tracer.at_parameter(current, new, bound, "end")
+            if end is not None:
+                extra.append(end)
+                stop = f"reached {'p_max' if bound == p_max else 'p_min'} = {bound:.10g}"
+            else:
+                points.append(new)
+                stop = f"left [p_min, p_max] (no cycle converged exactly at {bound:.10g})"
+            break
+        points.append(new)
+        if progress is not None:
+            progress(len(points), new.p)
+        amp = _scaled_amplitude(new)
+        if amp > amplitude_max:
+            stop = f"amplitude limit {amplitude_max:g} exceeded (largest scaled amplitude {amp:.6g})"
+            break
+        if new.sol.period > period_max:
+            stop = f"period limit {period_max:g} exceeded (period {new.sol.period:.6g})"
+            break
+        if len(points) > 4 and amp < 0.25 * amp0 and hopf is not None:
+            stop = "the cycles shrank back to an equilibrium (another Hopf point)"
+            break
+        # step control
+        it = new.sol.iterations
+        factor = 1.5 if it <= 2 else (1.0 if it <= 4 else 0.6)
+        step = min(max(step * factor, ds_min), ds_max)
+        current = new
+        if adapt_every and steps % adapt_every == 0:
+            current = tracer.remesh(current)
+            points[-1] = current
+    if points and stop.startswith(("maximum", "amplitude", "period", "no convergence", "the cycles")):
+        points[-1].label = points[-1].label or "end"
+    allpts = sorted(points + extra, key=lambda p: p.arclength)
+    cycles = tuple(_cycle(p) for p in allpts)
+    sp_points = tuple(SpecialPoint(kind, _cycle(pt), _TESTS[kind](pt), _critical_multiplier(kind, pt))
+                      for kind, pt in sorted(special, key=lambda kp: kp[1].arclength))
+    unreached = tuple(v for v in requested if v not in crossed)
+    settings = {"degree": degree, "intervals": int(intervals), "max_intervals": int(max_intervals),
+                "adapt_every": adapt_every, "mesh_tolerance": mesh_tolerance, "ds": ds, "ds_min": ds_min,
+                "ds_max": ds_max, "p_min": p_min, "p_max": p_max, "amplitude_max": amplitude_max,
+                "period_max": period_max, "max_points": max_points, "state_scale": list(map(float, weights.state)),
+                "period_scale": weights.period, "parameter_scale": weights.parameter,
+                "failed_corrections": tracer.failures}
+    return CycleBranch(cycles=cycles, hopf=hopf, special_points=sp_points, stop_reason=stop, unreached=unreached,
+                       settings=settings, state_names=system.state_names, state_units=system.state_units,
+                       parameter_name=system.parameter_name, parameter_units=system.parameter_units,
+                       time_units=system.time_units, warnings=tuple(warnings))
+
+
+def _scaled_amplitude(pt: _Point) -> float:
+    return float(np.max(pt.sol.profile.amplitude() / pt.problem.weights.state))
+
+
+def _check_positive(name: str, value: float) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(value) or value <= 0:
+        raise ModelError(name, value, "must be a positive finite number")
+
+
+def find_cycle(
+    f,
+    guess,
+    period: float,
+    p: float,
+    *,
+    n: int | None = None,
+    intervals: int = 40,
+    degree: int = 4,
+    period_scale: float | None = None,
+    parameter_scale: float = 1.0,
+) -> Cycle:
+    """A periodic orbit at fixed ``p`` by Newton's method on the collocation equations.
+
+    Parameters
+    ----------
+    f : DynamicalSystem or callable
+    guess : callable or (k, n) array
+        ``guess(tau) -> (len(tau), n)`` over the scaled time ``tau = t / T in [0, 1)``, or ``k``
+        states equally spaced in time over one period (e.g. from a time integration), which are
+        interpolated trigonometrically.
+    period : float
+        Period guess (time units).
+    p : float
+    n : int, optional
+        Number of states (taken from ``guess`` when it is an array).
+
+    Returns
+    -------
+    Cycle
+        With its Floquet multipliers; raises NumericalError when Newton's method fails.
+    """
+    if callable(guess):
+        if n is None:
+            n = int(np.asarray(guess(np.array([0.0]))).shape[-1])
+        fn = guess
+    else:
+        arr = np.asarray(guess, dtype=float)
+        if arr.ndim != 2 or arr.shape[0] < 4:
+            raise ModelError("guess", arr.shape, "must be a callable or an array (k >= 4 samples, n states)")
+        n = arr.shape[1]
+        fn = _trigonometric(arr)
+    system = as_system(f, n)
+    _check_positive("period", period)
+    weights = _settings_weights(system, period_scale or period, parameter_scale)
+    tracer = _Tracer(system, weights, degree, None, intervals)
+    prof = Profile.uniform(fn, intervals, degree)
+    prob = tracer.problem(prof.mesh)
+    sol = prob.solve(prob.pack(prof, period, p), prof, ("parameter", None, float(p), None), max_iter=40)
+    orient = np.zeros(prob.size)
+    orient[-1] = 1.0
+    pt = tracer.finish(prob, sol, prof, orient / prob.norm(orient), 0.0, "")
+    if pt is None:
+        raise NumericalError(f"no periodic orbit converged from the guess at p = {p:.10g}")
+    pt = tracer.remesh(pt)
+    return _cycle(pt)
+
+
+def _trigonometric(samples: Array):
+    k = samples.shape[0]
+    coef = np.fft.rfft(samples, axis=0) / k
+    freqs = np.arange(coef.shape[0])
+
+    def fn(tau):
+        tau = np.asarray(tau, dtype=float)
+        e = np.exp(2j * np.pi * tau[:, None] * freqs[None, :])
+        w = np.full(freqs.size, 2.0)
+        w[0] = 1.0
+        if k % 2 == 0:
+            w[-1] = 1.0
+        return np.real((e * w[None, :]) @ coef)
+
+    return fn
+
+
+def cycles_at(f, branch: CycleBranch, p: float) -> tuple[Cycle, ...]:
+    """Every cycle of ``branch`` at exactly ``p`` (Newton's method from each bracketing pair)."""
+    cyc = branch.cycles
+    if not cyc:
+        return ()
+    system = as_system(f, cyc[0].profile.nodes.shape[1])
+    st = branch.settings
+    weights = Weights(np.asarray(st.get("state_scale", system.state_scale), dtype=float),
+                      float(st.get("period_scale", cyc[0].period)), float(st.get("parameter_scale", 1.0)))
+    tracer = _Tracer(system, weights, cyc[0].profile.degree, None, 10 ** 6)
+    out = []
+    for a, b in zip(cyc[:-1], cyc[1:]):
+        if a.parameter == p:
+            out.append(a)
+            continue
+        if (a.parameter - p) * (b.parameter - p) < 0:
+            prob = tracer.problem(a.profile.mesh)
+            theta = (p - a.parameter) / (b.parameter - a.parameter)
+            nodes_b = b.profile.resample(a.profile.mesh).nodes
+            prof = Profile(a.profile.mesh, a.profile.nodes + theta * (nodes_b - a.profile.nodes), a.profile.degree)
+            guess = prob.pack(prof, a.period + theta * (b.period - a.period), p)
+            sol = prob.solve(guess, a.profile, ("parameter", None, float(p), None))
+            orient = np.zeros(prob.size)
+            orient[-1] = 1.0
+            pt = tracer.finish(prob, sol, a.profile, orient / prob.norm(orient),
+                               a.arclength + theta * (b.arclength - a.arclength), "requested")
+            if pt is None:
+                raise NumericalError(f"no cycle converged at p = {p:.10g} between branch points")
+            out.append(_cycle(pt))
+    if cyc[-1].parameter == p:
+        out.append(cyc[-1])
+    return tuple(out)
+
+
+def cycle_at(f, branch: CycleBranch, p: float, which: int = 0) -> Cycle:
+    """The ``which``-th cycle (in branch order) of ``branch`` at exactly ``p``.
+
+    Raises ModelError when the branch does not pass ``p`` (that often).
+    """
+    found = cycles_at(f, branch, p)
+    if not found or not -len(found) <= which < len(found):
+        lo, hi = float(branch.parameter.min()), float(branch.parameter.max())
+        raise ModelError("p", p, f"the branch passes it {len(found)} time(s) (it spans {lo:.10g} .. {hi:.10g})")
+    return found[which]
