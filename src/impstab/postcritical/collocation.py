@@ -183,35 +183,38 @@ class Profile:
         polishes it (the piecewise polynomial itself, not the samples, is measured).
         """
         sch = self.scheme
-        loc = self.local()
-        k = 4 * self.degree + 1
+        m = self.degree
+        coef = np.einsum("kj,ijn->ikn", sch.power, self.local())            # (N, m+1, n): coefficient of s^k
+        k = 4 * m + 1
         s = np.linspace(0.0, 1.0, k)
-        vals = np.einsum("sj,ijn->isn", sch.basis(s), loc)            # (N, k, n)
-        flat = vals.reshape(-1, vals.shape[-1])
-        lo = np.empty(flat.shape[1])
-        hi = np.empty(flat.shape[1])
-        for a in range(flat.shape[1]):
-            for sign, out in ((1.0, hi), (-1.0, lo)):
-                j = int(np.argmax(sign * flat[:, a]))
-                out[a] = sign * self._polish(loc[:, :, a], j // k, s[j % k], sign)
-        return lo, hi
-
-    def _polish(self, coeff: Array, i: int, s: float, sign: float) -> float:
-        sch = self.scheme
-        best = sign * float(sch.basis(np.array(s)) @ coeff[i])
+        vals = np.einsum("sk,ikn->isn", s[:, None] ** np.arange(m + 1), coef)  # (N, k, n)
+        n = vals.shape[-1]
+        flat = vals.reshape(-1, n)
+        sign = np.concatenate([np.ones(n), -np.ones(n)])                     # maxima, then minima
+        cols = np.concatenate([np.arange(n), np.arange(n)])
+        j = np.argmax(sign[None, :] * flat[:, cols], axis=0)
+        iv, sv = j // k, s[j % k]
+        # a sample on a mesh point: the extremum may lie in the neighbouring interval; polish both
+        n_int = coef.shape[0]
+        iv2 = np.where(sv == 0.0, (iv - 1) % n_int, np.where(sv == 1.0, (iv + 1) % n_int, iv))
+        sv2 = np.where(sv == 0.0, 1.0, np.where(sv == 1.0, 0.0, sv))
+        iv, sv = np.concatenate([iv, iv2]), np.concatenate([sv, sv2])
+        sign, cols = np.concatenate([sign, sign]), np.concatenate([cols, cols])
+        c = coef[iv, :, cols]                                                # (4n, m+1)
+        best = sign * np.sum(c * sv[:, None] ** np.arange(m + 1), axis=1)
+        powers = np.arange(m + 1)
         for _ in range(EXTREMUM_ITERATIONS):
-            d1 = float(sch.basis_derivative(np.array(s)) @ coeff[i])
-            d2 = float(sch.basis_derivative(np.array(s), 2) @ coeff[i])
-            if sign * d2 >= 0:       # not concave toward the extremum
-                break
-            s_new = s - d1 / d2
-            if s_new < 0.0 or s_new > 1.0:
-                break
-            val = sign * float(sch.basis(np.array(s_new)) @ coeff[i])
-            if val < best:
-                break
-            best, s = val, s_new
-        return best
+            d1 = np.sum(c[:, 1:] * powers[1:] * sv[:, None] ** (powers[1:] - 1), axis=1)
+            d2 = np.sum(c[:, 2:] * powers[2:] * (powers[2:] - 1) * sv[:, None] ** (powers[2:] - 2), axis=1)
+            ok = sign * d2 < 0
+            s_new = np.where(ok, sv - d1 / np.where(ok, d2, 1.0), sv)
+            s_new = np.clip(s_new, 0.0, 1.0)
+            val = sign * np.sum(c * s_new[:, None] ** powers, axis=1)
+            better = val >= best
+            sv = np.where(better, s_new, sv)
+            best = np.where(better, val, best)
+        best = np.maximum(best[: 2 * n], best[2 * n:])
+        return -best[n:], best[:n]
 
     def amplitude(self) -> Array:
         """Half the peak-to-peak of each state over the period, ``(n,)``."""

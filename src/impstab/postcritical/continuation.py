@@ -529,6 +529,8 @@ def find_cycle(
     n: int | None = None,
     intervals: int = 40,
     degree: int = 4,
+    mesh_tolerance: float | None = 1e-7,
+    max_intervals: int = 320,
     period_scale: float | None = None,
     parameter_scale: float = 1.0,
 ) -> Cycle:
@@ -546,6 +548,9 @@ def find_cycle(
     p : float
     n : int, optional
         Number of states (taken from ``guess`` when it is an array).
+    intervals, degree, mesh_tolerance, max_intervals
+        As in :func:`continue_cycles`: the mesh is equidistributed after the first solve and the
+        intervals doubled until the estimated relative profile error is below ``mesh_tolerance``.
 
     Returns
     -------
@@ -565,7 +570,7 @@ def find_cycle(
     system = as_system(f, n)
     _check_positive("period", period)
     weights = _settings_weights(system, period_scale or period, parameter_scale)
-    tracer = _Tracer(system, weights, degree, None, intervals)
+    tracer = _Tracer(system, weights, degree, mesh_tolerance, max(int(max_intervals), int(intervals)))
     prof = Profile.uniform(fn, intervals, degree)
     prob = tracer.problem(prof.mesh)
     sol = prob.solve(prob.pack(prof, period, p), prof, ("parameter", None, float(p), None), max_iter=40)
@@ -574,7 +579,11 @@ def find_cycle(
     pt = tracer.finish(prob, sol, prof, orient / prob.norm(orient), 0.0, "")
     if pt is None:
         raise NumericalError(f"no periodic orbit converged from the guess at p = {p:.10g}")
-    pt = tracer.remesh(pt)
+    for _ in range(8):
+        pt = tracer.remesh(pt)
+        if mesh_tolerance is None or tracer._relative_error(pt.sol.profile) <= mesh_tolerance \
+                or pt.sol.profile.intervals >= tracer.max_intervals:
+            break
     return _cycle(pt)
 
 

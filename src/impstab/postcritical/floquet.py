@@ -9,7 +9,7 @@ between the values at the mesh points, which are the collocation approximation o
 flow over that interval (superconvergent, ``O(h^2m)``). The monodromy matrix is the product
 ``(-B_(N-1)^-1 A_(N-1)) ... (-B_0^-1 A_0)``; forming it loses the small multipliers of strongly
 damped modes to rounding. Instead (Fairgrieve & Jepson 1991, AUTO's FLOWKM) ``v_1 .. v_(N-1)`` are
-eliminated one at a time by QR factorizations of ``[B_i; A_(i+1)]``, which keeps a relation
+eliminated by QR factorizations of ``[B_i; A_(i+1)]`` (pairwise, in a binary tree), which keeps a relation
 ``P v_0 + Q v_N = 0`` without any inverse, and the multipliers ``mu`` (``v_N = mu v_0``) are the
 eigenvalues of the pencil ``(P, -Q)`` by the QZ algorithm. Small and large multipliers keep their
 relative accuracy; the trivial multiplier (the phase direction ``x'(0)``) is found by its eigenvector.
@@ -81,16 +81,26 @@ def condense(blocks: Array) -> tuple[Array, Array]:
 
 
 def reduce_product(a: Array, b: Array) -> tuple[Array, Array]:
-    """``P v_0 + Q v_N = 0`` from the chain ``A_i v_i + B_i v_(i+1) = 0`` by QR eliminations."""
+    """``P v_0 + Q v_N = 0`` from the chain ``A_i v_i + B_i v_(i+1) = 0`` by QR eliminations.
+
+    Neighbouring relations ``P_k v_a + Q_k v_b = 0`` and ``P_(k+1) v_b + Q_(k+1) v_c = 0`` are merged
+    by the orthogonal factor of ``[Q_k; P_(k+1)]``, whose last ``n`` rows annihilate ``v_b``; the
+    merges of one level are batched (a binary tree of ``log2 N`` levels).
+    """
     n = a.shape[1]
-    p_mat, q_mat = a[0], b[0]
-    for i in range(1, a.shape[0]):
-        stack = np.concatenate([q_mat, a[i]], axis=0)              # columns of v_i
+    p_mat, q_mat = a, b
+    while p_mat.shape[0] > 1:
+        k = p_mat.shape[0] // 2 * 2
+        stack = np.concatenate([q_mat[0:k:2], p_mat[1:k:2]], axis=1)       # (k/2, 2n, n)
         qq, _ = np.linalg.qr(stack, mode="complete")
-        low = qq[:, n:].T                                           # annihilates the v_i columns
-        p_mat = low[:, :n] @ p_mat
-        q_mat = low[:, n:] @ b[i]
-    return p_mat, q_mat
+        low = np.swapaxes(qq[:, :, n:], 1, 2)                               # (k/2, n, 2n)
+        new_p = low[:, :, :n] @ p_mat[0:k:2]
+        new_q = low[:, :, n:] @ q_mat[1:k:2]
+        if k < p_mat.shape[0]:
+            new_p = np.concatenate([new_p, p_mat[k:]], axis=0)
+            new_q = np.concatenate([new_q, q_mat[k:]], axis=0)
+        p_mat, q_mat = new_p, new_q
+    return p_mat[0], q_mat[0]
 
 
 def multipliers(blocks: Array, phase_direction: Array, scale: Array) -> FloquetMultipliers:

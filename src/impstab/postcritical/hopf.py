@@ -86,7 +86,7 @@ class HopfPoint:
     omega : float or None
         Angular frequency at onset (rad per time unit); None for a divergence.
     eigenvector, adjoint : (n,) complex arrays or None
-        ``q`` (``A q = i omega q``, ``q^H q = 1``, largest component real positive) and ``p``
+        ``q`` (``A q = i omega q``, ``q^H q = 1``, its first largest component real positive) and ``p``
         (``A^H p = -i omega p``, ``p^H q = 1``) of the explicit state matrix ``A = B^-1 J``.
     lyapunov_coefficient : float or None
         First Lyapunov coefficient ``l1`` in Kuznetsov's normalisation (units
@@ -390,9 +390,11 @@ def _refine(system, x, p, lam, bracket):
 
 
 def _normalize(q: CArray) -> CArray:
+    """``q^H q = 1`` with the first of its largest components (ties within 1e-8) real positive."""
     q = q / np.linalg.norm(q)
-    k = int(np.argmax(np.abs(q)))
-    return q * (abs(q[k]) / q[k])
+    mag = np.abs(q)
+    k = int(np.flatnonzero(mag >= (1 - 1e-8) * mag.max())[0])
+    return q * (mag[k] / q[k])
 
 
 def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> HopfPoint:

@@ -10,6 +10,11 @@ _MARKERS = {"fold": ("s", "C3", "fold of cycles"), "period-doubling": ("D", "C4"
             "torus": ("^", "C2", "torus (Neimark-Sacker)")}
 
 
+def _fmt(value: float, scale: float) -> str:
+    """``value`` to 6 digits, rounding noise around zero (below 1e-12 of ``scale``) shown as 0."""
+    return "0" if abs(value) <= 1e-12 * abs(scale) else f"{value:.6g}"
+
+
 def _label(name: str, unit: str) -> str:
     return f"{name} ({unit})" if unit else name
 
@@ -27,6 +32,7 @@ def plot_branch(branch, ax=None, state=None, operating=None):
     else:
         j = branch.state_index(state)
     p = branch.parameter
+    pscale = max(float(np.max(np.abs(p))) if p.size else 1.0, float(branch.settings.get("parameter_scale", 1.0)))
     a = amp[:, j] if amp.size else np.array([])
     stable = branch.stable
     hopf = branch.hopf
@@ -48,12 +54,12 @@ def plot_branch(branch, ax=None, state=None, operating=None):
         k = e + 1
     if hopf is not None:
         ax.plot([hopf.parameter], [0.0], "o", color="k", ms=6, zorder=5,
-                label=f"Hopf point ({hopf.bifurcation}), {branch.parameter_name} = {hopf.parameter:.6g}")
+                label=f"Hopf point ({hopf.bifurcation}), {branch.parameter_name} = {_fmt(hopf.parameter, pscale)}")
     seen = set()
     for sp in branch.special_points:
         mk, col, name = _MARKERS[sp.kind]
         ax.plot([sp.parameter], [sp.cycle.amplitude[j]], mk, color=col, ms=7, zorder=6,
-                label=None if sp.kind in seen else f"{name}, {branch.parameter_name} = {sp.parameter:.6g}")
+                label=None if sp.kind in seen else f"{name}, {branch.parameter_name} = {_fmt(sp.parameter, pscale)}")
         seen.add(sp.kind)
     if operating is not None:
         ax.axvline(operating, color="0.35", ls=":", lw=1.0, label=f"operating {operating:.6g}")
