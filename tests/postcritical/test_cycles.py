@@ -126,3 +126,23 @@ def test_period_doubling_and_torus_at_their_exact_location(kind):
     assert all(c.stable for c in br.cycles if c.parameter < -1e-6)
     assert not any(c.stable for c in br.cycles if c.parameter > 1e-6)
     assert max(br.trivial_error) < 1e-10
+
+
+def test_condensed_newton_step_equals_the_full_sparse_solve(vdp_cycle):
+    """Condensation of parameters against SuperLU on the whole bordered Jacobian (random right side)."""
+    import scipy.sparse.linalg as spla
+
+    from impstab.postcritical.condensed import Condensation
+    from impstab.postcritical.periodic import OrbitProblem, Weights
+
+    prof = vdp_cycle.profile
+    prob = OrbitProblem(van_der_pol(), prof.mesh, prof.degree, Weights(np.ones(2), 6.0, 1.0))
+    u = prob.pack(prof, vdp_cycle.period * 1.01, 1.05)
+    res, blocks, col_t, col_p = prob.evaluate(u)
+    rng = np.random.default_rng(3)
+    phase = prob.phase_row(prof)
+    last = rng.standard_normal(prob.size)
+    rhs = rng.standard_normal(prob.size)
+    full = spla.spsolve(prob.matrix(blocks, col_t, col_p, phase, last), rhs)
+    cond = Condensation(blocks, col_t, col_p).solve(rhs[:-2], np.stack([np.concatenate([phase, [0, 0]]), last]), rhs[-2:])
+    assert np.max(np.abs(cond - full)) <= 1e-10 * np.max(np.abs(full))

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from ..errors import NumericalError
 
-__all__ = ["FloquetMultipliers", "condense", "multipliers"]
+__all__ = ["FloquetMultipliers", "condense", "multipliers", "chain_multipliers", "reduce_product"]
 
 Array = NDArray[np.float64]
 CArray = NDArray[np.complex128]
@@ -115,6 +115,11 @@ def multipliers(blocks: Array, phase_direction: Array, scale: Array) -> FloquetM
         State scale for the alignment test.
     """
     a, b = condense(blocks)
+    return chain_multipliers(a, b, phase_direction, scale)
+
+
+def chain_multipliers(a: Array, b: Array, phase_direction: Array, scale: Array) -> FloquetMultipliers:
+    """Floquet multipliers from the condensed chain ``A_i v_i + B_i v_(i+1) = 0``, ``(N, n, n)`` each."""
     p_mat, q_mat = reduce_product(a, b)
     try:
         mu, vec = sla.eig(p_mat, -q_mat, right=True)

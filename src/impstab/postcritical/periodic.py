@@ -5,8 +5,8 @@ Equations: the ``N m n`` collocation equations, the integral phase condition
 ``int_0^1 <x(tau) - x_ref(tau), x_ref'(tau)> dtau = 0`` (``x_ref`` the previous cycle: the new one
 is the shift of it that moves least) and one constraint: pseudo-arclength
 ``<U - U_0, V_0> = ds`` or a fixed parameter ``p = p*``. Inner products are the weighted ones of
-:class:`Weights`. The Jacobian is assembled as a scipy.sparse matrix (``(m + 1) m n^2`` entries per
-interval plus two dense rows) and factorized by SuperLU.
+:class:`Weights`. Newton's linear systems are solved by condensation of parameters
+(:mod:`.condensed`); :meth:`OrbitProblem.matrix` assembles the full sparse Jacobian for checks.
 """
 
 from __future__ import annotations
@@ -20,7 +20,8 @@ from numpy.typing import NDArray
 
 from .collocation import Profile, interval_nodes, node_weights, scheme
 from .derivatives import jacobians, parameter_derivatives
-from .floquet import FloquetMultipliers, multipliers
+from .condensed import Condensation
+from .floquet import FloquetMultipliers, chain_multipliers
 from .system import DynamicalSystem
 
 __all__ = ["Weights", "OrbitProblem", "Solution", "NEWTON_TOLERANCE", "NEWTON_ITERATIONS"]
@@ -50,8 +51,7 @@ class Solution:
     parameter: float
     vector: Array
     blocks: Array
-    col_period: Array
-    col_parameter: Array
+    condensed: Condensation
     phase: Array
     iterations: int
     residual: float
@@ -155,6 +155,7 @@ class OrbitProblem:
         kind, u0, target, v0 = constraint
         u = np.array(guess, dtype=float)
         phase = self.phase_row(ref)
+        phase_full = np.concatenate([phase, [0.0, 0.0]])
         ref_vec = ref.nodes.reshape(-1)
         if kind == "arclength":
             last = self.inner_weights * v0
@@ -174,15 +175,15 @@ class OrbitProblem:
             full = np.concatenate([res, [g_phase, g_last]])
             if not np.all(np.isfinite(full)):
                 return None
+            cond = Condensation(blocks, col_t, col_p)
             if converged:
-                return Solution(self.profile(u), float(u[-2]), float(u[-1]), u, blocks, col_t, col_p, phase, it,
+                return Solution(self.profile(u), float(u[-2]), float(u[-1]), u, blocks, cond, phase, it,
                                 float(np.max(np.abs(res))))
             if it == max_iter:
                 return None
-            mat = self.matrix(blocks, col_t, col_p, phase, last)
             try:
-                step = spla.splu(mat).solve(-full)
-            except RuntimeError:
+                step = cond.solve(-res, np.stack([phase_full, last]), -np.array([g_phase, g_last]))
+            except (RuntimeError, np.linalg.LinAlgError):
                 return None
             if not np.all(np.isfinite(step)):
                 return None
@@ -196,13 +197,12 @@ class OrbitProblem:
 
     def tangent(self, sol: Solution, ref: Profile, orient: Array) -> Array:
         """Unit tangent of the branch at ``sol`` (weighted norm), oriented along ``orient``."""
-        mat = self.matrix(sol.blocks, sol.col_period, sol.col_parameter, sol.phase, self.inner_weights * orient)
-        rhs = np.zeros(self.size)
-        rhs[-1] = 1.0
-        v = spla.splu(mat).solve(rhs)
+        phase_full = np.concatenate([sol.phase, [0.0, 0.0]])
+        v = sol.condensed.solve(np.zeros(self.nx), np.stack([phase_full, self.inner_weights * orient]),
+                                np.array([0.0, 1.0]))
         v = v / self.norm(v)
         return v if self.inner(v, orient) >= 0 else -v
 
     def floquet(self, sol: Solution) -> FloquetMultipliers:
         d = sol.profile.derivative(np.array([0.0]))[0]
-        return multipliers(sol.blocks, d, self.weights.state)
+        return chain_multipliers(sol.condensed.a, sol.condensed.b, d, self.weights.state)
