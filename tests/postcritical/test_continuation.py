@@ -121,8 +121,23 @@ def rossler_branch():
     system = rossler()
     h = hopf_analysis(system, rossler_equilibrium(0.12), 0.12)
     near = [h.parameter + d for d in (2e-4, 4e-4, 8e-4)]
-    br = continue_cycles(system, h, 0.3, parameters=near + [0.25], ds=0.005, ds_max=0.5)
+    br = continue_cycles(system, h, 0.36, parameters=near + [0.25], ds=0.005, ds_max=0.5)
     return system, h, br, near
+
+
+#: first period doubling of the Rossler cycle (b = 2, c = 4) and its period: AUTO-07p 0.9.2,
+#: NTST = 80, NCOL = 4, EPSL = EPSU = 1e-10, EPSS = 1e-8 (NTST = 20 gives 0.33485662243)
+AUTO_PD_A, AUTO_PD_PERIOD = 0.33485662256, 6.1799339812
+
+
+def test_rossler_period_doubling_against_auto(rossler_branch):
+    _, _, br, _ = rossler_branch
+    pd = [s for s in br.special_points if s.kind == "period-doubling"]
+    assert len(pd) == 1 and [s.kind for s in br.special_points] == ["period-doubling"]
+    assert pd[0].parameter == pytest.approx(AUTO_PD_A, abs=2e-10)
+    assert pd[0].period == pytest.approx(AUTO_PD_PERIOD, abs=2e-9)
+    assert abs(pd[0].multiplier + 1) < 1e-8
+    assert all(c.stable == (c.parameter < pd[0].parameter) for c in br.cycles if abs(c.parameter - AUTO_PD_A) > 1e-6)
 
 
 def test_normal_form_amplitude_converges_like_the_parameter_distance(rossler_branch):

@@ -179,10 +179,10 @@ def test_undamped_pair_below_the_collision_stays_on_the_axis():
 
 
 def test_damped_follower_system_is_a_plain_hopf_point():
-    """With dashpots the onset is a simple crossing (Ziegler: p_cr -> 41/28 + b^2/2 for small b)."""
+    """With equal dashpots the onset is a simple crossing at Ziegler's p_cr = 41/28 + b^2/2 (THEORY 10)."""
     b = 0.02
     h = hopf_analysis(_ziegler(b), np.zeros(4), 1.47)
-    assert h.parameter == pytest.approx(41 / 28 + b ** 2 / 2, rel=2e-3)
+    assert h.parameter == pytest.approx(41 / 28 + b ** 2 / 2, rel=1e-12)
     assert h.bifurcation in ("supercritical", "subcritical") and h.reason is None
     assert h.lyapunov_error < 1e-6 * abs(h.lyapunov_coefficient)
 

@@ -485,7 +485,7 @@ def continue_cycles(
             break
         # step control
         it = new.sol.iterations
-        factor = 1.5 if it <= 2 else (1.0 if it <= 4 else 0.6)
+        factor = 1.5 if it <= 3 else (1.0 if it <= 5 else 0.6)
         step = min(max(step * factor, ds_min), ds_max)
         current = new
         if adapt_every and steps % adapt_every == 0:
