@@ -194,3 +194,37 @@ def test_bad_inputs():
         hopf_analysis(bautin(0.5), [0.0, 0.0], 0.1, bracket=(0.1, 0.2))
     with pytest.raises(ModelError, match="bracket"):
         hopf_analysis(bautin(0.5), [0.0, 0.0], 0.1, bracket=(0.2, -0.1))
+
+
+def test_real_parameter_only_falls_back_to_central_differences():
+    base = bautin(0.7)
+
+    def f(x, p):
+        if isinstance(p, complex) or np.iscomplexobj(p):
+            raise TypeError("real parameter only")
+        return base.rhs(x, p)
+
+    system = DynamicalSystem(f, 2, vectorized=True, complex_parameter=False)
+    h = hopf_analysis(system, [1e-3, 0.0], 0.05)
+    assert h.parameter_derivative_method == "central-difference-4"
+    assert h.crossing_speed == pytest.approx(1.0, rel=1e-9)
+    assert h.lyapunov_coefficient == pytest.approx(1.4, rel=1e-11)
+
+
+def test_analytic_derivatives_give_the_same_coefficient():
+    """The Bautin system's derivatives at the origin by hand: B = 0 and, from the cubic p2 x (x.x),
+    C(u, v, w) = 2 p2 [u (v.w) + v (w.u) + w (u.v)] (the terms r^2 x are of fifth order)."""
+    p2 = -0.5
+    base = bautin(p2)
+
+    def third(x, p, u, v, w):
+        def sym(a, b, c):
+            return a * (b[0] * c[0] + b[1] * c[1])
+        return 2 * p2 * (sym(u, v, w) + sym(v, w, u) + sym(w, u, v))
+
+    system = DynamicalSystem(lambda x, p: base.rhs(x[None], p)[0], 2,
+                             second_derivative=lambda x, p, u, v: np.zeros(2, dtype=complex),
+                             third_derivative=third)
+    h = hopf_analysis(system, [0.0, 0.0], 0.05)
+    assert h.derivative_method == "analytic"
+    assert h.lyapunov_coefficient == pytest.approx(2 * p2, rel=1e-12)

@@ -7,7 +7,8 @@ normal form (radius, parameter and period at that amplitude, second-order shape)
 guess. Each later step predicts along the unit tangent ``V_k`` and corrects with Newton's method
 under ``<U - U_k, V_k> = ds`` (Keller's pseudo-arclength), so folds are passed without special
 treatment. The step grows after quick convergence, shrinks after slow convergence, a failure or a
-sharp turn of the tangent. The mesh is re-equidistributed every ``adapt_every`` steps (AUTO's IAD)
+sharp turn of the tangent, and is scaled so that the tangent turns by about 0.1 rad per step (a
+smooth diagram: more points where the branch bends). The mesh is re-equidistributed every ``adapt_every`` steps (AUTO's IAD)
 and the number of intervals doubled while the estimated profile error exceeds ``mesh_tolerance``.
 
 On every accepted step the test functions are compared with the previous point's and each sign
@@ -48,6 +49,8 @@ Array = NDArray[np.float64]
 
 #: a step is rejected when the tangent turns by more than this (cosine of the angle)
 MIN_TANGENT_COSINE = 0.9
+#: the step is scaled so that the tangent turns by about this much per step (rad)
+TARGET_TURN = 0.1
 #: real multiplier: |Im mu| below this share of max(1, |mu|)
 REAL_MULTIPLIER = 1e-7
 #: stability margin floor (see Cycle.stability_tolerance)
@@ -486,6 +489,9 @@ def continue_cycles(
         # step control
         it = new.sol.iterations
         factor = 1.5 if it <= 3 else (1.0 if it <= 5 else 0.6)
+        angle = math.acos(min(1.0, max(-1.0, current.problem.inner(new.tangent, current.tangent))))
+        if angle > 0:
+            factor = min(factor, max(0.5, TARGET_TURN / angle))
         step = min(max(step * factor, ds_min), ds_max)
         current = new
         if adapt_every and steps % adapt_every == 0:

@@ -53,12 +53,12 @@ def plot_branch(branch, ax=None, state=None, operating=None):
         drawn[s] = True
         k = e + 1
     if hopf is not None:
-        ax.plot([hopf.parameter], [0.0], "o", color="k", ms=6, zorder=5,
+        ax.plot([hopf.parameter], [0.0], "o", color="k", ms=6, zorder=5, clip_on=False,
                 label=f"Hopf point ({hopf.bifurcation}), {branch.parameter_name} = {_fmt(hopf.parameter, pscale)}")
     seen = set()
     for sp in branch.special_points:
         mk, col, name = _MARKERS[sp.kind]
-        ax.plot([sp.parameter], [sp.cycle.amplitude[j]], mk, color=col, ms=7, zorder=6,
+        ax.plot([sp.parameter], [sp.cycle.amplitude[j]], mk, color=col, ms=7, zorder=6, clip_on=False,
                 label=None if sp.kind in seen else f"{name}, {branch.parameter_name} = {_fmt(sp.parameter, pscale)}")
         seen.add(sp.kind)
     if operating is not None:
@@ -95,5 +95,6 @@ def plot_phase_portrait(branch, index=-1, states=(0, 1), ax=None):
     ax.set_ylabel(_label(names[j], units[j]))
     ax.set_title(f"cycle at {branch.parameter_name} = {cyc.parameter:.6g} {branch.parameter_units}".rstrip())
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize="small")
+    # below the axes: a closed curve leaves no free corner for a legend inside
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, fontsize="small", frameon=False)
     return ax
