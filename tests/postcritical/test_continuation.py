@@ -121,8 +121,17 @@ def rossler_branch():
     system = rossler()
     h = hopf_analysis(system, rossler_equilibrium(0.12), 0.12)
     near = [h.parameter + d for d in (2e-4, 4e-4, 8e-4)]
-    br = continue_cycles(system, h, 0.36, parameters=near + [0.25], ds=0.005, ds_max=0.5)
+    br = continue_cycles(system, h, 0.36, parameters=near + [0.25, h.parameter + 2e-8], ds=0.005, ds_max=0.5)
     return system, h, br, near
+
+
+def test_requested_value_before_the_first_step_comes_from_the_normal_form(rossler_branch):
+    _, h, br, _ = rossler_branch
+    p = h.parameter + 2e-8
+    assert br.cycles[0].parameter == p and br.cycles[1].label == "start"   # closer to onset than the first step
+    c = br.requested(p)[0]
+    assert c.amplitude == pytest.approx(h.predicted_amplitude(p), rel=1e-5)
+    assert br.unreached == ()
 
 
 #: first period doubling of the Rossler cycle (b = 2, c = 4) and its period: AUTO-07p 0.9.2,

@@ -228,3 +228,18 @@ def test_analytic_derivatives_give_the_same_coefficient():
     h = hopf_analysis(system, [0.0, 0.0], 0.05)
     assert h.derivative_method == "analytic"
     assert h.lyapunov_coefficient == pytest.approx(2 * p2, rel=1e-12)
+
+
+def test_nearly_symmetric_pair_is_a_hopf_point_with_a_warning():
+    """Two oscillators 1e-5 apart in frequency: a simple crossing, but the neighbour is named."""
+    def f(x, p):
+        s1 = x[:, 0] ** 2 + x[:, 1] ** 2
+        s2 = x[:, 2] ** 2 + x[:, 3] ** 2
+        w2 = 1.0 + 1e-5
+        return np.stack([p * x[:, 0] - x[:, 1] - (s1 + 2 * s2) * x[:, 0], p * x[:, 1] + x[:, 0] - (s1 + 2 * s2) * x[:, 1],
+                         (p - 1e-5) * x[:, 2] - w2 * x[:, 3] - (s2 + 2 * s1) * x[:, 2],
+                         (p - 1e-5) * x[:, 3] + w2 * x[:, 2] - (s2 + 2 * s1) * x[:, 3]], axis=-1)
+
+    h = hopf_analysis(DynamicalSystem(f, 4, vectorized=True), np.zeros(4), 0.001)
+    assert h.bifurcation == "supercritical" and h.lyapunov_coefficient == pytest.approx(-2.0, rel=1e-10)
+    assert any("another eigenvalue" in w for w in h.warnings)

@@ -301,6 +301,29 @@ def _hopf_start(tracer: _Tracer, hopf: HopfPoint, intervals: int, ds: float) -> 
     return pt
 
 
+def _normal_form_point(tracer: _Tracer, hopf: HopfPoint, first: _Point, p: float) -> _Point | None:
+    """The cycle at ``p`` between the Hopf point and the first cycle, from the normal-form guess."""
+    prob = first.problem
+    mesh = prob.mesh
+    try:
+        rho = float(hopf.normal_form_radius(p))
+    except ModelError:
+        return None
+    if not math.isfinite(rho):
+        return None
+    tau = Profile(mesh, first.sol.profile.nodes, first.sol.profile.degree).node_times()
+    z = rho * np.exp(2j * np.pi * tau)
+    q = hopf.eigenvector
+    nodes = ((hopf.state + hopf.equilibrium_slope * (p - hopf.parameter))[None, :] + 2 * np.real(z[:, None] * q[None, :])
+             + np.real(z[:, None] ** 2 * hopf.h20[None, :]) + rho ** 2 * hopf.h11[None, :])
+    guess_prof = Profile(mesh, nodes, first.sol.profile.degree)
+    guess = prob.pack(guess_prof, float(hopf.predicted_period(p)), p)
+    sol = prob.solve(guess, guess_prof, ("parameter", None, p, None))
+    rho_first = float(hopf.normal_form_radius(first.p))
+    share = rho / rho_first if math.isfinite(rho_first) and rho_first > rho else 0.5
+    return tracer.finish(prob, sol, guess_prof, first.tangent, share * first.arclength, "requested")
+
+
 def _cycle_start(tracer: _Tracer, cycle: Cycle, direction: int) -> _Point:
     prof = cycle.profile
     prob = tracer.problem(prof.mesh)
@@ -423,6 +446,19 @@ def continue_cycles(
     crossed: set[float] = set()
     warnings: list[str] = []
     amp0 = _scaled_amplitude(first)
+    if hopf is not None and hopf.bifurcation != "degenerate":
+        # requested values between the Hopf point and the first cycle: from the normal form
+        for v in requested:
+            if (hopf.parameter - v) * (first.p - v) < 0 or first.p == v:
+                pt = first if first.p == v else _normal_form_point(tracer, hopf, first, v)
+                if pt is None:
+                    warnings.append(f"no cycle converged at the requested p = {v:.10g} next to the Hopf point")
+                    continue
+                if pt is first:
+                    first.label = "requested"
+                else:
+                    extra.append(pt)
+                crossed.add(v)
     step = ds
     steps = 0
     stop = "maximum number of points reached"

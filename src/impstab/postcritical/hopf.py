@@ -62,6 +62,8 @@ COLLISION_PRODUCT = 0.05
 SYMMETRY_TOLERANCE = 1e-8
 #: crossing speed below this share of |d lambda / dp|: no transversal crossing
 TRANSVERSALITY_TOLERANCE = 1e-9
+#: a plain Hopf point with another eigenvalue this close (share of the spectral radius): a warning
+NEAR_RESONANCE = 1e-3
 #: |l1| at most this many times its error bound: l1 = 0 to its accuracy
 L1_ZERO_FACTOR = 10.0
 #: Newton refinement of the onset: |Re lambda| below this share of |lambda|
@@ -444,6 +446,10 @@ def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> H
                          frequency_slope=float(dlam.imag) if transversal else None,
                          bifurcation="degenerate", reason=reason, h20=None, h11=None,
                          equilibrium_slope=x_p if transversal else None, warnings=tuple(warnings), **base)
+    others = np.delete(spec.eigenvalues, idx)
+    if others.size and np.min(np.abs(others - lam)) <= NEAR_RESONANCE * scale:
+        warnings.append(f"another eigenvalue lies within {np.min(np.abs(others - lam)) / scale:.1e} (relative) of the "
+                        "critical one: the single-pair normal form holds only very close to the onset")
     if lam.imag < 0:
         q, w, lam = np.conj(q), np.conj(w), np.conj(lam)
     om = lam.imag
