@@ -243,3 +243,14 @@ def test_bad_continuation_inputs():
     # l1 = 0 still starts (AUTO-like, along the eigenvector); other degenerate onsets do not
     br = continue_cycles(bautin(0.0), degenerate, 0.2, max_points=30, ds_max=0.3)
     assert br.cycles[-1].amplitude[0] ** 2 == pytest.approx(bautin_radius(br.cycles[-1].parameter, 0.0, 1), rel=1e-9)
+
+
+def test_amplitude_and_point_limits_stop_the_branch():
+    system = bautin(-0.5)
+    h = hopf_analysis(system, [1e-3, 0.0], 0.05)
+    br = continue_cycles(system, h, 10.0, amplitude_max=0.5, ds_max=0.3)
+    assert br.stop_reason.startswith("amplitude limit 0.5 exceeded")
+    assert np.max(br.amplitude[:-1]) <= 0.5 < np.max(br.amplitude[-1])
+    br = continue_cycles(system, h, 10.0, max_points=5)
+    assert br.stop_reason == "maximum number of points reached" and len(br) == 6   # the start and 5 steps
+    assert br.labels[0] == "start" and br.labels[-1] == "end"
