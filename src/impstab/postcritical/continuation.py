@@ -27,21 +27,19 @@ from the interpolated cycle), and so is the end point at ``p_min`` / ``p_max``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
 from ..errors import ModelError, NumericalError
 from .collocation import Profile
-from .floquet import FloquetMultipliers
+from .events import TESTS, critical_multiplier, events, locate
 from .hopf import HopfPoint
-from .mesh import equidistribute, error_indicator
-from .periodic import OrbitProblem, Solution, Weights
+from .periodic import Weights
 from .result import Cycle, CycleBranch, SpecialPoint
-from .system import DynamicalSystem, as_system
+from .system import as_system
+from .tracing import BranchPoint, Tracer, to_cycle
 
 __all__ = ["continue_cycles", "find_cycle", "cycle_at", "cycles_at"]
 
@@ -51,212 +49,6 @@ Array = NDArray[np.float64]
 MIN_TANGENT_COSINE = 0.9
 #: the step is scaled so that the tangent turns by about this much per step (rad)
 TARGET_TURN = 0.1
-#: real multiplier: |Im mu| below this share of max(1, |mu|)
-REAL_MULTIPLIER = 1e-7
-#: stability margin floor (see Cycle.stability_tolerance)
-STABILITY_FLOOR = 1e-9
-#: relative accuracy of the arclength of a located special point
-LOCATE_XTOL = 1e-12
-
-
-@dataclass
-class _Point:
-    sol: Solution
-    problem: OrbitProblem
-    tangent: Array
-    floquet: FloquetMultipliers
-    arclength: float
-    label: str = ""
-
-    @property
-    def u(self) -> Array:
-        return self.sol.vector
-
-    @property
-    def p(self) -> float:
-        return self.sol.parameter
-
-
-class _Tracer:
-    """The working state of one continuation run."""
-
-    def __init__(self, system: DynamicalSystem, weights: Weights, degree: int, mesh_tolerance: float | None,
-                 max_intervals: int) -> None:
-        self.system = system
-        self.weights = weights
-        self.degree = degree
-        self.mesh_tolerance = mesh_tolerance
-        self.max_intervals = max_intervals
-        self.problems: dict[bytes, OrbitProblem] = {}
-        self.failures = 0
-
-    def problem(self, mesh: Array) -> OrbitProblem:
-        key = mesh.tobytes()
-        if key not in self.problems:
-            if len(self.problems) > 8:
-                self.problems.clear()
-            self.problems[key] = OrbitProblem(self.system, mesh, self.degree, self.weights)
-        return self.problems[key]
-
-    def finish(self, prob: OrbitProblem, sol: Solution | None, ref: Profile, orient: Array, s: float,
-               label: str = "") -> _Point | None:
-        if sol is None:
-            self.failures += 1
-            return None
-        try:
-            tangent = prob.tangent(sol, ref, orient)
-            floq = prob.floquet(sol)
-        except (RuntimeError, NumericalError, np.linalg.LinAlgError):
-            self.failures += 1
-            return None
-        if not np.all(np.isfinite(tangent)):
-            return None
-        return _Point(sol, prob, tangent, floq, s, label)
-
-    def correct(self, base: _Point, ds: float, label: str = "") -> _Point | None:
-        prob = base.problem
-        guess = base.u + ds * base.tangent
-        sol = prob.solve(guess, base.sol.profile, ("arclength", base.u, ds, base.tangent))
-        return self.finish(prob, sol, base.sol.profile, base.tangent, base.arclength + ds, label)
-
-    def at_parameter(self, a: _Point, b: _Point, p_star: float, label: str) -> _Point | None:
-        prob = a.problem
-        theta = (p_star - a.p) / (b.p - a.p) if b.p != a.p else 0.5
-        guess = a.u + theta * (b.u - a.u)
-        guess[-1] = p_star
-        sol = prob.solve(guess, a.sol.profile, ("parameter", None, p_star, None))
-        return self.finish(prob, sol, a.sol.profile, a.tangent, a.arclength + theta * (b.arclength - a.arclength),
-                           label)
-
-    def remesh(self, pt: _Point) -> _Point:
-        """The point on an equidistributed mesh (more intervals while the error is too large)."""
-        scale = self.weights.state
-        prof = pt.sol.profile
-        intervals = prof.intervals
-        err = self._relative_error(prof)
-        if self.mesh_tolerance is not None and err > self.mesh_tolerance:
-            intervals = min(2 * intervals, self.max_intervals)
-        new_mesh = equidistribute(prof, scale, intervals)
-        prob = self.problem(new_mesh)
-        new_prof = prof.resample(new_mesh)
-        tan_prof = Profile(prof.mesh, pt.tangent[:-2].reshape(prof.nodes.shape), prof.degree).resample(new_mesh)
-        orient = prob.pack(tan_prof, pt.tangent[-2], pt.tangent[-1])
-        guess = prob.pack(new_prof, pt.sol.period, pt.p)
-        sol = prob.solve(guess, new_prof, ("parameter", None, pt.p, None))
-        new = self.finish(prob, sol, new_prof, orient / max(prob.norm(orient), 1e-300), pt.arclength, pt.label)
-        return pt if new is None else new
-
-    def _relative_error(self, prof: Profile) -> float:
-        err, _ = error_indicator(prof, self.weights.state)
-        amp = float(np.max(prof.amplitude() / self.weights.state))
-        return err / max(amp, 1e-300)
-
-
-def _cycle(pt: _Point, label: str | None = None) -> Cycle:
-    prof = pt.sol.profile
-    lo, hi = prof.extrema()
-    fl = pt.floquet
-    tol = max(STABILITY_FLOOR, 10.0 * fl.trivial_error)
-    stable = fl.largest < 1.0
-    err, _ = error_indicator(prof, pt.problem.weights.state)
-    return Cycle(parameter=pt.p, period=pt.sol.period, profile=prof, multipliers=fl.values, trivial=fl.trivial,
-                 trivial_error=fl.trivial_error, stable=bool(stable), stability_tolerance=tol,
-                 amplitude=0.5 * (hi - lo), minimum=lo, maximum=hi, mean=prof.mean(), mesh_error=err,
-                 arclength=pt.arclength, label=pt.label if label is None else label,
-                 newton_iterations=pt.sol.iterations)
-
-
-# ----------------------------------------------------------------------- test functions
-def _real_below_minus_one(pt: _Point) -> int:
-    nt = pt.floquet.nontrivial
-    real = np.abs(nt.imag) <= REAL_MULTIPLIER * np.maximum(1.0, np.abs(nt))
-    return int(np.sum(real & (nt.real < -1.0)))
-
-
-def _complex_outside(pt: _Point) -> int:
-    nt = pt.floquet.nontrivial
-    cplx = np.abs(nt.imag) > REAL_MULTIPLIER * np.maximum(1.0, np.abs(nt))
-    return int(np.sum(cplx & (np.abs(nt) > 1.0)))
-
-
-def _pd_test(pt: _Point) -> float:
-    nt = pt.floquet.nontrivial
-    real = np.abs(nt.imag) <= REAL_MULTIPLIER * np.maximum(1.0, np.abs(nt))
-    if not np.any(real & (nt.real < 0)):
-        return math.nan
-    cand = nt[real & (nt.real < 0)].real
-    return float(cand[np.argmin(np.abs(cand + 1.0))] + 1.0)
-
-
-def _ns_test(pt: _Point) -> float:
-    nt = pt.floquet.nontrivial
-    cplx = np.abs(nt.imag) > REAL_MULTIPLIER * np.maximum(1.0, np.abs(nt))
-    if not np.any(cplx):
-        return math.nan
-    mod = np.abs(nt[cplx])
-    return float(mod[np.argmin(np.abs(mod - 1.0))] - 1.0)
-
-
-def _fold_test(pt: _Point) -> float:
-    return float(pt.tangent[-1])
-
-
-_TESTS: dict[str, Callable[[_Point], float]] = {"fold": _fold_test, "period-doubling": _pd_test, "torus": _ns_test}
-
-
-def _critical_multiplier(kind: str, pt: _Point) -> complex | None:
-    nt = pt.floquet.nontrivial
-    if kind == "fold":
-        return complex(nt[np.argmin(np.abs(nt - 1.0))]) if nt.size else None
-    if kind == "period-doubling":
-        return complex(nt[np.argmin(np.abs(nt + 1.0))])
-    cplx = nt[np.abs(nt.imag) > 0]
-    return complex(cplx[np.argmin(np.abs(np.abs(cplx) - 1.0))]) if cplx.size else None
-
-
-def _events(a: _Point, b: _Point) -> list[str]:
-    out = []
-    if _fold_test(a) * _fold_test(b) < 0:
-        out.append("fold")
-    if (_real_below_minus_one(a) - _real_below_minus_one(b)) % 2 == 1:
-        ta, tb = _pd_test(a), _pd_test(b)
-        if math.isfinite(ta) and math.isfinite(tb) and ta * tb < 0:
-            out.append("period-doubling")
-    if _complex_outside(a) != _complex_outside(b):
-        ta, tb = _ns_test(a), _ns_test(b)
-        if math.isfinite(ta) and math.isfinite(tb) and ta * tb < 0:
-            out.append("torus")
-    return out
-
-
-def _locate(tracer: _Tracer, a: _Point, b: _Point, kind: str) -> _Point | None:
-    test = _TESTS[kind]
-    ds_total = b.arclength - a.arclength
-    memo: dict[float, _Point] = {}
-
-    def g(s: float) -> float:
-        if s <= 0:
-            return test(a)
-        if s >= ds_total:
-            return test(b)
-        pt = tracer.correct(a, s, kind)
-        if pt is None:
-            raise NumericalError(f"no convergence while locating a {kind}")
-        memo[s] = pt
-        val = test(pt)
-        if not math.isfinite(val):
-            raise NumericalError(f"the {kind} test function is undefined inside its bracket")
-        return val
-
-    try:
-        s_star = brentq(g, 0.0, ds_total, xtol=LOCATE_XTOL * max(1.0, abs(ds_total)), rtol=4 * np.finfo(float).eps,
-                        maxiter=60)
-    except (NumericalError, ValueError, RuntimeError):
-        return None
-    pt = memo.get(s_star) or tracer.correct(a, s_star, kind)
-    if pt is not None:
-        pt.label = kind
-    return pt
 
 
 # ----------------------------------------------------------------------- starting points
@@ -264,7 +56,7 @@ def _settings_weights(system, period_scale, parameter_scale) -> Weights:
     return Weights(np.asarray(system.state_scale, dtype=float), float(period_scale), float(parameter_scale))
 
 
-def _hopf_start(tracer: _Tracer, hopf: HopfPoint, intervals: int, ds: float) -> _Point:
+def _hopf_start(tracer: Tracer, hopf: HopfPoint, intervals: int, ds: float) -> BranchPoint:
     if hopf.onset != "hopf" or hopf.eigenvector is None or not hopf.omega:
         raise ModelError("hopf", hopf.bifurcation, "cycles start from a Hopf point (a complex pair at onset); "
                          f"this onset is a {hopf.onset}")
@@ -301,7 +93,7 @@ def _hopf_start(tracer: _Tracer, hopf: HopfPoint, intervals: int, ds: float) -> 
     return pt
 
 
-def _normal_form_point(tracer: _Tracer, hopf: HopfPoint, first: _Point, p: float) -> _Point | None:
+def _normal_form_point(tracer: Tracer, hopf: HopfPoint, first: BranchPoint, p: float) -> BranchPoint | None:
     """The cycle at ``p`` between the Hopf point and the first cycle, from the normal-form guess."""
     prob = first.problem
     mesh = prob.mesh
@@ -324,7 +116,7 @@ def _normal_form_point(tracer: _Tracer, hopf: HopfPoint, first: _Point, p: float
     return tracer.finish(prob, sol, guess_prof, first.tangent, share * first.arclength, "requested")
 
 
-def _cycle_start(tracer: _Tracer, cycle: Cycle, direction: int) -> _Point:
+def _cycle_start(tracer: Tracer, cycle: Cycle, direction: int) -> BranchPoint:
     prof = cycle.profile
     prob = tracer.problem(prof.mesh)
     guess = prob.pack(prof, cycle.period, cycle.parameter)
@@ -431,7 +223,7 @@ def continue_cycles(
             raise ModelError("parameters", v, "must be finite numbers")
     t0 = (2 * math.pi / start.omega) if isinstance(start, HopfPoint) and start.omega else getattr(start, "period", 1.0)
     weights = _settings_weights(system, period_scale or t0, parameter_scale)
-    tracer = _Tracer(system, weights, degree, mesh_tolerance, int(max_intervals))
+    tracer = Tracer(system, weights, degree, mesh_tolerance, int(max_intervals))
     if isinstance(start, HopfPoint):
         first = _hopf_start(tracer, start, int(intervals), ds)
         hopf = start
@@ -440,9 +232,9 @@ def continue_cycles(
         hopf = None
     if adapt_every:
         first = tracer.remesh(first)
-    points: list[_Point] = [first]
-    extra: list[_Point] = []
-    special: list[tuple[str, _Point]] = []
+    points: list[BranchPoint] = [first]
+    extra: list[BranchPoint] = []
+    special: list[tuple[str, BranchPoint]] = []
     crossed: set[float] = set()
     warnings: list[str] = []
     amp0 = _scaled_amplitude(first)
@@ -480,8 +272,8 @@ def continue_cycles(
             continue
         steps += 1
         # events between current and new
-        for kind in _events(current, new):
-            loc = _locate(tracer, current, new, kind)
+        for kind in events(current, new):
+            loc = locate(tracer, current, new, kind)
             if loc is None:
                 warnings.append(f"a {kind} between p = {current.p:.10g} and {new.p:.10g} could not be located")
                 continue
@@ -536,8 +328,8 @@ def continue_cycles(
     if points and stop.startswith(("maximum", "amplitude", "period", "no convergence", "the cycles")):
         points[-1].label = points[-1].label or "end"
     allpts = sorted(points + extra, key=lambda p: p.arclength)
-    cycles = tuple(_cycle(p) for p in allpts)
-    sp_points = tuple(SpecialPoint(kind, _cycle(pt), _TESTS[kind](pt), _critical_multiplier(kind, pt))
+    cycles = tuple(to_cycle(p) for p in allpts)
+    sp_points = tuple(SpecialPoint(kind, to_cycle(pt), TESTS[kind](pt), critical_multiplier(kind, pt))
                       for kind, pt in sorted(special, key=lambda kp: kp[1].arclength))
     unreached = tuple(v for v in requested if v not in crossed)
     settings = {"degree": degree, "intervals": int(intervals), "max_intervals": int(max_intervals),
@@ -552,7 +344,7 @@ def continue_cycles(
                        time_units=system.time_units, warnings=tuple(warnings))
 
 
-def _scaled_amplitude(pt: _Point) -> float:
+def _scaled_amplitude(pt: BranchPoint) -> float:
     return float(np.max(pt.sol.profile.amplitude() / pt.problem.weights.state))
 
 
@@ -612,7 +404,7 @@ def find_cycle(
     system = as_system(f, n)
     _check_positive("period", period)
     weights = _settings_weights(system, period_scale or period, parameter_scale)
-    tracer = _Tracer(system, weights, degree, mesh_tolerance, max(int(max_intervals), int(intervals)))
+    tracer = Tracer(system, weights, degree, mesh_tolerance, max(int(max_intervals), int(intervals)))
     prof = Profile.uniform(fn, intervals, degree)
     prob = tracer.problem(prof.mesh)
     sol = prob.solve(prob.pack(prof, period, p), prof, ("parameter", None, float(p), None), max_iter=40)
@@ -623,10 +415,10 @@ def find_cycle(
         raise NumericalError(f"no periodic orbit converged from the guess at p = {p:.10g}")
     for _ in range(8):
         pt = tracer.remesh(pt)
-        if mesh_tolerance is None or tracer._relative_error(pt.sol.profile) <= mesh_tolerance \
+        if mesh_tolerance is None or tracer.relative_error(pt.sol.profile) <= mesh_tolerance \
                 or pt.sol.profile.intervals >= tracer.max_intervals:
             break
-    return _cycle(pt)
+    return to_cycle(pt)
 
 
 def _trigonometric(samples: Array):
@@ -655,7 +447,7 @@ def cycles_at(f, branch: CycleBranch, p: float) -> tuple[Cycle, ...]:
     st = branch.settings
     weights = Weights(np.asarray(st.get("state_scale", system.state_scale), dtype=float),
                       float(st.get("period_scale", cyc[0].period)), float(st.get("parameter_scale", 1.0)))
-    tracer = _Tracer(system, weights, cyc[0].profile.degree, None, 10 ** 6)
+    tracer = Tracer(system, weights, cyc[0].profile.degree, None, 10 ** 6)
     out = []
     for a, b in zip(cyc[:-1], cyc[1:]):
         if a.parameter == p:
@@ -674,7 +466,7 @@ def cycles_at(f, branch: CycleBranch, p: float) -> tuple[Cycle, ...]:
                                a.arclength + theta * (b.arclength - a.arclength), "requested")
             if pt is None:
                 raise NumericalError(f"no cycle converged at p = {p:.10g} between branch points")
-            out.append(_cycle(pt))
+            out.append(to_cycle(pt))
     if cyc[-1].parameter == p:
         out.append(cyc[-1])
     return tuple(out)
