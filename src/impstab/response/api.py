@@ -100,6 +100,7 @@ def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearizat
     sol = harmonic_response(
         lin.M[None], lin.D[None], lin.G[None], lin.K[None], lin.rotation[None], pos, km, cm,
         2.0 * np.pi * f, loads[None], fluid=fluid_extra, foundation=hull,
+        fluid_damping=np.zeros((1, 6, 6)),  # linearize takes the fluid at 0 Hz: no radiation damping in lin.D
     )
     md = modes(model, thrust, linearization)
     warnings: list[str] = []

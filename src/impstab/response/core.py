@@ -131,6 +131,7 @@ def harmonic_response(
     loads: CArray,
     fluid: CArray | None = None,
     foundation: CArray | None = None,
+    fluid_damping: Array | None = None,
 ) -> HarmonicSolution:
     """Forced response, mount and hull forces and powers of ``nd`` designs at ``nf`` frequencies.
 
@@ -155,6 +156,10 @@ def harmonic_response(
     foundation : (nd or 1, nf, nm) complex array, optional
         Dynamic stiffness ``S = i omega Z`` of the hull at each attachment (N/m); None, or
         ``inf``, for a rigid hull.
+    fluid_damping : (nd, 6, 6) array, optional
+        The frequency-independent fluid part of ``damping`` (for the power split); default
+        ``damping - sum B_i^T c_i B_i`` with entries below 1e-12 of ``max |damping|`` (the
+        rounding of that difference) set to 0.
 
     Returns
     -------
@@ -175,13 +180,18 @@ def harmonic_response(
         hull = np.asarray(foundation, dtype=complex)
         hull = c(np.broadcast_to(hull, (hull.shape[0], nf, nm)), complex)
     loads = np.asarray(loads, dtype=complex)
+    if fluid_damping is None:
+        d_fluid = np.asarray(damping, float) - _sandwich(b, cm)
+        scale = np.abs(np.asarray(damping, float)).max(axis=(-2, -1), keepdims=True)
+        d_fluid = np.where(np.abs(d_fluid) <= 1e-12 * scale, 0.0, d_fluid)
+    else:
+        d_fluid = np.broadcast_to(np.asarray(fluid_damping, float), (nd, 6, 6))
     q, pivot = solve_harmonic(
         c(mass), c(np.asarray(damping, float) + np.asarray(gyroscopic, float)), k, w, c(loads, complex), extra, b, km, cm, hull
     )
     d, x_hull, force, hull_force, p_in, p_thr, p_fl, p_dmp, p_tr = response_outputs(
         q, w, c(loads, complex), extra, b, c((km @ b)[..., :3, :]), c((cm @ b)[..., :3, :]),
-        c(np.swapaxes(b, -1, -2) @ cm @ b), km, cm, hull, c(k - _sandwich(b, km)),
-        c(np.asarray(damping, float) - _sandwich(b, cm)),
+        c(np.swapaxes(b, -1, -2) @ cm @ b), km, cm, hull, c(k - _sandwich(b, km)), c(d_fluid),
     )
     return HarmonicSolution(
         omega=w, response=q, deflection=d, hull_displacement=x_hull, mount_force=force,

@@ -74,7 +74,10 @@ def eliminate(a, b):  # pragma: no cover - compiled
             acc = b[i, j]
             for c in range(i + 1, n):
                 acc -= a[i, c] * b[c, j]
-            b[i, j] = acc / a[i, i]
+            if a[i, i] == 0.0:
+                b[i, j] = complex(np.nan, np.nan)  # singular: numba's complex division would raise
+            else:
+                b[i, j] = acc / a[i, i]
     return small / big if big > 0.0 else 0.0
 
 

@@ -3,9 +3,9 @@
 At the static equilibrium of the linearization (THEORY 4; gravity and buoyancy neglected, so the
 loads come from the thrust alone) each mount's body end has moved by
 ``e_i = (u0 + R0 r_i - r_i, log R0)`` (equilibrium; classically ``T6(r_i) q0`` from linear
-statics ``K_c q0 = [T e; r_T x T e]``). The mount pushes the hull with
-``[F_i; M_i] = k_i e_i`` (force and moment at its hull end, hull axes); the forces sum to the
-thrust vector. Deflection and force split along the mount axis ``a`` (axial, signed) and normal
+statics ``K_c q0 = [T e; r_T x T e]``). The mount pushes the hull with the force
+``F_i = (k_i e_i)_t`` and, with rotational stiffness, the moment ``M_i = J_l^{-T} (k_i e_i)_r``
+(hull axes); the forces sum to the thrust vector. Deflection and force split along the mount axis ``a`` (axial, signed) and normal
 to it (shear, magnitude). With the optional ratings of a mount (``rated_force`` N,
 ``max_deflection`` m) the utilisations are ``|F_i| / rated_force`` and ``|d_i| / max_deflection``;
 above 1 a warning names the mount.
@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ModelError
-from ..kinematics import rigid_map6, rotation_from_vector, rotation_vector
+from ..kinematics import inverse_left_jacobian, rigid_map6, rotation_from_vector, rotation_vector
 from ..linear.linearize import linearize, pack_model
 from ..linear.tangent import classical_forms
 from ..model.model import LINEARIZATIONS, Model
@@ -30,7 +30,12 @@ Array = NDArray[np.float64]
 
 
 def static_loads_batch(positions: Array, stiffness: Array, translation: Array, rotation: Array, exact: bool = True):
-    """Body-end deflections ``e (nd, nm, 6)`` and mount loads ``k e (nd, nm, 6)`` of many designs.
+    """Body-end deflections ``e (nd, nm, 6)`` and mount loads ``(nd, nm, 6)`` of many designs.
+
+    The load of a mount on the hull is ``[F; M] = [(k e)_t; J_l^{-T}(phi) (k e)_r]``: the force
+    ``(k e)_t`` and, for a mount with rotational stiffness, the moment conjugate to the spatial
+    rotation (THEORY 4: the elastic potential ``1/2 e^T k e`` in ``phi = log R``; ``J_l = I``
+    for classical statics).
 
     Parameters
     ----------
@@ -60,6 +65,9 @@ def static_loads_batch(positions: Array, stiffness: Array, translation: Array, r
         e[..., :3] = (rigid_map6(pos) @ q0[:, None, :, None])[..., :3, 0]
     e[..., 3:] = phi[:, None, :]
     load = (np.asarray(stiffness, dtype=float) @ e[..., None])[..., 0]
+    if exact:
+        for d in range(nd):
+            load[d, :, 3:] = load[d, :, 3:] @ inverse_left_jacobian(phi[d])   # rows: J^-T g
     return e, load
 
 
