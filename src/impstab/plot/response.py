@@ -55,7 +55,9 @@ def _mark_modes(ax, result, lo: float, hi: float) -> None:
     top.xaxis.set_major_locator(FixedLocator(freqs))
     top.xaxis.set_minor_locator(NullLocator())
     top.set_xticklabels([n + "\n" * r for n, r in zip(numbers, rows)], fontsize="x-small", linespacing=1.0)
-    top.set_xlabel("mode (damped natural frequencies at this thrust)", fontsize="x-small")
+    rigid = not str(result.settings.get("foundation", "rigid")).startswith("compliant")
+    top.set_xlabel("mode (damped natural frequencies at this thrust" + ("" if rigid else ", on a rigid hull") + ")",
+                   fontsize="x-small")
 
 
 def _hz_axis(ax, lo: float, hi: float) -> None:
@@ -70,9 +72,10 @@ def _hz_axis(ax, lo: float, hi: float) -> None:
 
 
 def _legend(ax) -> None:
-    handles, labels = ax.get_legend_handles_labels()
-    extra = [a for a in ax.artists if a.get_label().startswith("mode ")]
-    ax.legend(handles + extra, labels + [a.get_label() for a in extra], loc="upper left",
+    """Legend outside the axes on the right: the curves first, then the mode list."""
+    pairs = list(zip(*ax.get_legend_handles_labels()))
+    pairs = [p for p in pairs if not p[1].startswith("mode ")] + [p for p in pairs if p[1].startswith("mode ")]
+    ax.legend([h for h, _ in pairs], [lab for _, lab in pairs], loc="upper left",
               bbox_to_anchor=(1.01, 1.0), fontsize="x-small", frameon=False, handlelength=1.5)
 
 
