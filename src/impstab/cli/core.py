@@ -140,7 +140,7 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
     for j, dom in enumerate(res.dominant()):
         t.add_row(
             str(j + 1), f"{res.frequency_hz[j]:.6g}", f"{res.omega[j]:.6g}", f"{res.damping_ratio[j] + 0.0:.4g}",
-            f"{res.growth_rate[j] + 0.0:.4g}", "/".join(dom), *(f"{100 * v + 0.0:.1f}" for v in res.participation[j]),
+            f"{res.growth_rate[j] + 0.0:.4g}", "/".join(dom), *(f"{round(100 * v, 1) + 0.0:.1f}" for v in res.participation[j]),
         )
     con = console()
     con.print(t)

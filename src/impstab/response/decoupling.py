@@ -8,7 +8,8 @@ At the thrust of the linearization (hull axes, points from A at the static pose)
 * **Torque roll axis (TRA)**: the axis about which the free body turns under a torque about the
   thrust axis ``e`` (the propeller's torque fluctuation): the screw axis of the acceleration
   ``M^-1 [0; e]`` (direction ``alpha = (M^-1 [0; e])_rot``, through ``p = alpha x a_A / |alpha|^2``);
-  it passes through the mass centre. A roll mode whose rotation axis lies on the TRA is excited by
+  for a dry body it passes through the cg (with added mass, through the wet inertial centre only
+  approximately). A roll mode whose rotation axis lies on the TRA is excited by
   that torque alone (Jeong and Singh, J. Sound Vib. 234 (2000) 85-114).
 * **Roll-mode axis**: the rotation axis of the roll mode's shape (its phase turned so the roll
   component is real): direction ``theta / |theta|``, through ``theta x u_A / |theta|^2``.
@@ -99,6 +100,11 @@ class DecouplingCheck:
         return _angle_deg(self.torque_roll_axis, self.thrust_axis)
 
     @property
+    def tra_offset(self) -> float:
+        """Distance of the mass centre from the torque roll axis (m; 0 for a dry body)."""
+        return _line_distance(self.mass_centre, self.torque_roll_point, self.torque_roll_axis)
+
+    @property
     def roll_axis_angle_deg(self) -> float:
         """Angle between the roll mode's axis and the torque roll axis (deg)."""
         return _angle_deg(self.roll_axis, self.torque_roll_axis)
@@ -126,22 +132,28 @@ class DecouplingCheck:
     def lines(self) -> list[str]:
         """The check in words, one finding a line (for ``impstab modes``)."""
         verdict = "decoupled" if self.roll_decoupled else "coupled"
-        fmt = lambda v: "[" + ", ".join(f"{x:.4g}" for x in v) + "]"  # noqa: E731
+
+        def fmt(v):  # rounding noise below 1e-12 of the vector's size shown as 0
+            tiny = 1e-12 * max(float(np.abs(v).max()), 1e-3)
+            return "[" + ", ".join(f"{(x if abs(x) > tiny else 0.0):.4g}" for x in v) + "]"
+
+        num = lambda x, unit=1.0: f"{(x * unit if abs(x) > 1e-12 else 0.0):.3g}"  # noqa: E731
         return [
             f"roll mode {self.roll_mode + 1} ({self.roll_frequency_hz:.4g} Hz): roll share {100 * self.roll_share:.1f} % "
             f"({verdict}; decoupled from {100 * self.threshold:.0f} %)",
             f"torque roll axis (free body under a torque about the thrust axis): direction {fmt(self.torque_roll_axis)}, "
-            f"{self.tra_angle_deg:.3g} deg from the thrust axis, through the mass centre {fmt(self.mass_centre)} m",
-            f"roll-mode axis: {self.roll_axis_angle_deg:.3g} deg from the torque roll axis, "
-            f"{1e3 * self.roll_axis_offset:.3g} mm from the mass centre",
-            f"elastic centre {fmt(self.elastic_centre)} m: {1e3 * self.centre_offset:.3g} mm from the mass centre, "
-            f"{1e3 * self.thrust_line_offset:.3g} mm from the thrust line; coupling left there {100 * self.elastic_coupling:.3g} %",
-            f"elastic roll axis: {self.elastic_axis_angle_deg:.3g} deg from the thrust axis",
+            f"{num(self.tra_angle_deg)} deg from the thrust axis, {num(self.tra_offset, 1e3)} mm from the mass centre "
+            f"{fmt(self.mass_centre)} m",
+            f"roll-mode axis: {num(self.roll_axis_angle_deg)} deg from the torque roll axis, "
+            f"{num(self.roll_axis_offset, 1e3)} mm from the mass centre",
+            f"elastic centre {fmt(self.elastic_centre)} m: {num(self.centre_offset, 1e3)} mm from the mass centre, "
+            f"{num(self.thrust_line_offset, 1e3)} mm from the thrust line; coupling left there {num(self.elastic_coupling, 100)} %",
+            f"elastic roll axis: {num(self.elastic_axis_angle_deg)} deg from the thrust axis",
         ]
 
     def to_dict(self) -> dict:
         out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()}
-        out.update(roll_decoupled=self.roll_decoupled, tra_angle_deg=self.tra_angle_deg,
+        out.update(roll_decoupled=self.roll_decoupled, tra_angle_deg=self.tra_angle_deg, tra_offset=self.tra_offset,
                    roll_axis_angle_deg=self.roll_axis_angle_deg, roll_axis_offset=self.roll_axis_offset,
                    centre_offset=self.centre_offset, thrust_line_offset=self.thrust_line_offset,
                    elastic_axis_angle_deg=self.elastic_axis_angle_deg)
