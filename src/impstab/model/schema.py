@@ -98,6 +98,7 @@ DofName = Literal["surge", "sway", "heave", "roll", "pitch", "yaw"]
 Count = Annotated[int, Field(ge=1, le=1000, strict=True)]
 Table = Annotated[list[NonNegative], Field(min_length=1, max_length=100000)]
 Rows6 = Annotated[list[Row6], Field(min_length=1, max_length=100000)]
+Values = Annotated[list[Finite], Field(max_length=100000)]
 
 
 class UnbalanceSpec(_Strict):
@@ -135,10 +136,10 @@ class FoundationSpec(_Strict):
     stiffness: NonNegative = 0.0        # N/m     (lumped)
     damping: NonNegative = 0.0          # N s/m   (lumped)
     frequency_hz: Optional[Table] = None            # Hz (tables), strictly increasing
-    mobility_real: Optional[list[Finite]] = None    # m/(N s) (mobility-table)
-    mobility_imag: Optional[list[Finite]] = None
-    impedance_real: Optional[list[Finite]] = None   # N s/m (impedance-table)
-    impedance_imag: Optional[list[Finite]] = None
+    mobility_real: Optional[Values] = None    # m/(N s) (mobility-table)
+    mobility_imag: Optional[Values] = None
+    impedance_real: Optional[Values] = None   # N s/m (impedance-table)
+    impedance_imag: Optional[Values] = None
 
 
 class ModelFile(_Strict):

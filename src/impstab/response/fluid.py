@@ -6,7 +6,7 @@ resistances ``R``, ``R_rot`` depend on frequency. One evaluation of
 to about 1e-12), so a sweep of 1e4 frequencies would spend tens of seconds there. Instead:
 
 * up to :data:`DIRECT_LIMIT` distinct frequencies: each is evaluated directly;
-* more: the four coefficients (as ``m_a``, ``R / omega``, ``I_a``, ``R_rot / omega``, all smooth
+* more (unless the panels below would need more evaluations than that): the four coefficients (as ``m_a``, ``R / omega``, ``I_a``, ``R_rot / omega``, all smooth
   in frequency and finite at 0) are interpolated on Chebyshev panels of degree :data:`DEGREE`
   over the analysed range, each panel halved until its last three Chebyshev coefficients are
   below :data:`TOLERANCE` times the panel's ``|Z_T| / omega`` (``|Z_R| / omega`` for rotation).
@@ -88,8 +88,13 @@ def _direct(model: Model, f: Array) -> tuple[Array, float]:
     return out, err
 
 
-def _chebyshev(model: Model, f: Array) -> tuple[Array, int, float, float]:
-    """Adaptive Chebyshev panels over ``[f.min(), f.max()]`` evaluated at ``f``."""
+def _chebyshev(model: Model, f: Array) -> tuple[Array, int, float, float] | None:
+    """Adaptive Chebyshev panels over ``[f.min(), f.max()]`` evaluated at ``f``; None when the
+    panels would need more evaluations than ``f`` has frequencies (then direct evaluation is cheaper).
+
+    A panel is accepted when its Chebyshev tail is below :data:`TOLERANCE`, or below 100 times
+    the quadrature error of its nodes where that is larger (the values carry that error anyway).
+    """
     x = np.cos(np.pi * np.arange(DEGREE + 1) / DEGREE)  # Chebyshev-Lobatto points on [-1, 1]
     out = np.empty((f.size, 4))
     evaluations = 0
@@ -101,13 +106,15 @@ def _chebyshev(model: Model, f: Array) -> tuple[Array, int, float, float]:
         nodes = 0.5 * (lo + hi) + 0.5 * (hi - lo) * x
         vals, err = _direct(model, nodes)
         evaluations += nodes.size
+        if evaluations > f.size:
+            return None
         quad = max(quad, err)
         coef = cheb.chebfit(x, vals, DEGREE)              # (DEGREE + 1, 4), exact interpolation
         scale_t = np.hypot(vals[:, 0], vals[:, 1]).max()
         scale_r = np.hypot(vals[:, 2], vals[:, 3]).max()
         scale = np.array([scale_t, scale_t, scale_r, scale_r])
         tail = (np.abs(coef[-3:]).max(axis=0) / np.where(scale > 0, scale, 1.0)).max()
-        if tail > TOLERANCE and depth < _MAX_DEPTH and hi > lo:
+        if tail > max(TOLERANCE, 100.0 * err) and depth < _MAX_DEPTH and hi > lo:
             mid = 0.5 * (lo + hi)
             stack += [(lo, mid, depth + 1), (mid, hi, depth + 1)]
             continue
@@ -124,11 +131,12 @@ def fluid_spectrum(model: Model, frequency_hz: Array) -> FluidSpectrum | None:
         return None
     f = np.asarray(frequency_hz, dtype=float).reshape(-1)
     uniq, inverse = np.unique(f, return_inverse=True)
-    if uniq.size <= DIRECT_LIMIT:
+    panels = _chebyshev(model, uniq) if uniq.size > DIRECT_LIMIT else None
+    if panels is None:
         vals, quad = _direct(model, uniq)
         method, evaluations, interp = "direct", uniq.size, 0.0
     else:
-        vals, evaluations, interp, quad = _chebyshev(model, uniq)
+        vals, evaluations, interp, quad = panels
         method = "chebyshev"
     vals = vals[inverse]
     w = 2.0 * np.pi * f
