@@ -1,7 +1,7 @@
 """Forced response and vibration isolation: transmissibility, mount and hull forces, transmitted
 power, one-third-octave band levels, static mount loads, the mount system's decoupling.
 
->>> import impstab
+>>> import numpy as np, impstab
 >>> from impstab.response import frequency_response
 >>> model = impstab.load_model("examples/imp_isolation.toml")           # doctest: +SKIP
 >>> res = frequency_response(model, np.linspace(1, 100, 400))           # doctest: +SKIP
