@@ -149,13 +149,14 @@ def harmonic_response(
     omega : (nf,) array
         Angular frequencies (rad/s), >= 0.
     loads : (nd or 1, nf or 1, 6) complex array
-        Generalized load amplitudes at A, hull axes (N, N m).
+        Generalized load amplitudes at A, hull axes (N, N m); ``(6,)`` and ``(nf, 6)`` are
+        shared by all designs.
     fluid : (nd, nf, 6, 6) complex array, optional
         Frequency-dependent fluid part of the dynamic stiffness
         (:func:`~impstab.response.fluid.fluid_dynamic_stiffness`).
     foundation : (nd or 1, nf, nm) complex array, optional
         Dynamic stiffness ``S = i omega Z`` of the hull at each attachment (N/m); None, or
-        ``inf``, for a rigid hull.
+        ``inf`` (per attachment), for a rigid hull. ``(nf, nm)`` is shared by all designs.
     fluid_damping : (nd, 6, 6) array, optional
         The frequency-independent fluid part of ``damping`` (for the power split); default
         ``damping - sum B_i^T c_i B_i`` with entries below 1e-12 of ``max |damping|`` (the
@@ -178,8 +179,10 @@ def harmonic_response(
     hull = np.zeros((1, 0, nm), dtype=complex)
     if foundation is not None and not np.all(np.isinf(foundation)):
         hull = np.asarray(foundation, dtype=complex)
+        hull = hull.reshape((1,) * (3 - hull.ndim) + hull.shape)        # (nf, nm) -> (1, nf, nm)
         hull = c(np.broadcast_to(hull, (hull.shape[0], nf, nm)), complex)
     loads = np.asarray(loads, dtype=complex)
+    loads = loads.reshape((1,) * (3 - loads.ndim) + loads.shape)        # (6,) or (nf, 6) -> (1, ., 6)
     if fluid_damping is None:
         d_fluid = np.asarray(damping, float) - _sandwich(b, cm)
         scale = np.abs(np.asarray(damping, float)).max(axis=(-2, -1), keepdims=True)
