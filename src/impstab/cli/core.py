@@ -74,6 +74,41 @@ def check_cmd(model_file: str) -> None:
     con.print(t)
     md = modes(model, 0.0)
     con.print("natural frequencies at zero thrust (Hz): " + ", ".join(f"{f:.4g}" for f in md.frequency_hz))
+    _static_loads_table(model, con)
+
+
+def _static_loads_table(model, con) -> None:
+    """Static deflection and load of each mount at the operating thrust, with utilisations."""
+    from rich.table import Table
+
+    from ..errors import NumericalError
+    from ..response.static import static_mount_loads
+
+    if not model.thrust.operating:
+        con.print("static mount loads: no operating thrust (thrust.operating), so none are reported")
+        return
+    try:
+        st = static_mount_loads(model)
+    except NumericalError as exc:
+        con.print(f"[yellow]warning:[/yellow] static mount loads at the operating thrust: {exc}")
+        return
+    t = Table(title=f"static mount deflection and load at the operating thrust {st.thrust:g} N ({st.linearization})")
+    for col in ("mount", "position (m)", "axial d (mm)", "shear d (mm)", "|d| (mm)", "axial F (N)", "shear F (N)",
+                "|F| (N)", "utilisation"):
+        t.add_column(col, justify="left" if col in ("mount", "position (m)") else "right")
+    util = st.utilisation
+    for i, m in enumerate(model.mounts):
+        u = "-" if not np.isfinite(util[i]) else (f"[red]{100 * util[i]:.0f} %[/red]" if util[i] > 1 else f"{100 * util[i]:.0f} %")
+        t.add_row(
+            str(i), str(np.round(m.position, 4).tolist()), f"{1e3 * st.axial_deflection[i]:.4g}",
+            f"{1e3 * st.shear_deflection[i]:.4g}", f"{1e3 * st.deflection_magnitude[i]:.4g}",
+            f"{st.axial_force[i]:.5g}", f"{st.shear_force[i]:.5g}", f"{st.force_magnitude[i]:.5g}", u,
+        )
+    con.print(t)
+    con.print("d: body-end deflection of the attachment from the unloaded pose; F: force of the mount on the hull; "
+              "utilisation: the larger of |F| / rated_force and |d| / max_deflection")
+    for w in st.warnings:
+        con.print(f"[yellow]warning:[/yellow] {w}")
 
 
 @click.command("modes")
@@ -81,33 +116,47 @@ def check_cmd(model_file: str) -> None:
 @click.option("--thrust", type=float, default=0.0, show_default=True, help="thrust T (N)")
 @click.option("--linearization", type=LINEARIZATION, default=None, help="override the model's setting")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json: bool) -> None:
-    """Natural frequencies, damping, growth rates and mode shapes at a thrust."""
+@click.option("--shapes", is_flag=True, help="also print the mode shapes at A")
+def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json: bool, shapes: bool) -> None:
+    """Natural frequencies, damping, growth rates, the decoupling table and mode shapes at a thrust."""
     from rich.table import Table
 
     from ..linear.modes import modes
     from ..model.model import DOF_NAMES
+    from ..response.decoupling import decoupling_check
 
     check_number("--thrust", thrust, nonneg=True)
     model = _load(model_file)
     res = modes(model, thrust, linearization)
+    check = decoupling_check(model, thrust, linearization, modal=res)
     if as_json:
-        print_json(res.to_dict())
+        print_json({**res.to_dict(), "decoupling": check.to_dict()})
         return
-    t = Table(title=f"modes of {model.name} at T = {thrust:g} N ({res.linearization})")
+    t = Table(title=f"modes of {model.name} at T = {thrust:g} N ({res.linearization}): kinetic-energy shares (%)")
     for col in ("mode", "f (Hz)", "omega (rad/s)", "zeta", "growth (1/s)", "dominant"):
         t.add_column(col)
     for name in DOF_NAMES:
-        t.add_column(f"|{name}|", justify="right")
+        t.add_column(name, justify="right")
     for j, dom in enumerate(res.dominant()):
         t.add_row(
-            str(j + 1), f"{res.frequency_hz[j]:.6g}", f"{res.omega[j]:.6g}", f"{res.damping_ratio[j]:.4g}",
-            f"{res.growth_rate[j]:.4g}", ", ".join(dom), *(f"{abs(v):.3f}" for v in res.shapes[:, j]),
+            str(j + 1), f"{res.frequency_hz[j]:.6g}", f"{res.omega[j]:.6g}", f"{res.damping_ratio[j] + 0.0:.4g}",
+            f"{res.growth_rate[j] + 0.0:.4g}", "/".join(dom), *(f"{round(100 * v, 1) + 0.0:.1f}" for v in res.participation[j]),
         )
     con = console()
     con.print(t)
-    con.print("shapes: displacement of A (m) and rotation (rad), largest component 1; "
-              + ("stable" if res.stable else "[red]UNSTABLE[/red]"))
+    con.print("shares: each dof's part of the mode's kinetic energy in mass-centre coordinates (rows sum to 100); "
+              "dominant: the largest share (with any within 1 point of it); " + ("stable" if res.stable else "[red]UNSTABLE[/red]"))
+    if shapes:
+        st = Table(title="mode shapes at A: displacement (m) and rotation (rad), largest component 1")
+        st.add_column("mode")
+        for name in DOF_NAMES:
+            st.add_column(f"|{name}|", justify="right")
+        for j in range(res.shapes.shape[1]):
+            st.add_row(str(j + 1), *(f"{abs(v):.3f}" for v in res.shapes[:, j]))
+        con.print(st)
+    con.print("[bold]decoupling[/bold]")
+    for line in check.lines():
+        con.print("  " + line)
 
 
 @click.command("locus")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ from pydantic import ValidationError
 
 from ..errors import ModelError
 from .body import RigidBody
+from .isolation_specs import excitation_from_spec, foundation_from_spec
 from .fluid import FluidLoading, Hull
 from .model import AnalysisSettings, Model
 from .mounts import Mount, axial_shear_matrix, elastic_stiffness, ring_positions
@@ -126,12 +128,13 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             axis = unit_vector(m.axis, f"{f}.axis")
             c6 = np.zeros((6, 6))
             c6[:3, :3] = axial_shear_matrix(axis, m.c_axial, m.c_shear)
-        mounts.append(Mount(pos, k6, c6))
+        mounts.append(Mount(pos, k6, c6, unit_vector(m.axis, f"{f}.axis"), m.rated_force, m.max_deflection))
     for i, ring in enumerate(doc.mount_rings):
         f = f"mount_rings[{i}]"
         axis = unit_vector(ring.axis, f"{f}.axis")
         for pos in ring_positions(ring.count, ring.radius, ring.x, ring.start_angle):
-            mounts.append(Mount.axial_shear(pos, axis, ring.k_axial, ring.k_shear, ring.c_axial, ring.c_shear))
+            mount = Mount.axial_shear(pos, axis, ring.k_axial, ring.k_shear, ring.c_axial, ring.c_shear)
+            mounts.append(replace(mount, rated_force=ring.rated_force, max_deflection=ring.max_deflection))
     if not mounts:
         raise ModelError("mounts", [], "the model needs at least one mount or mount ring")
     kc = elastic_stiffness(mounts)
@@ -196,6 +199,7 @@ def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
         body=body, mounts=mounts, thrust=thrust,
         analysis=AnalysisSettings(float(thrust_max), doc.analysis.linearization),
         propeller=prop, fluid=fluid, hull=hull, name=name, source=source,
+        excitation=excitation_from_spec(doc.excitation, prop), foundation=foundation_from_spec(doc.foundation),
     )
 
 
