@@ -15,7 +15,8 @@ from __future__ import annotations
 
 from .schema_doc import RefEntry as E
 
-__all__ = ["MODEL_REFERENCE", "TITLE", "INTRO", "DOC_PATH", "label", "markdown_page", "json_schema_document"]
+__all__ = ["MODEL_REFERENCE", "TITLE", "INTRO", "DOC_PATH", "label", "unit", "markdown_page",
+           "json_schema_document"]
 
 DOC_PATH = "docs/model-file.md"
 TITLE = "Model-file reference"
@@ -131,6 +132,19 @@ path = "./impstab-model.schema.json"
 
 Study files have their own reference, `docs/study-file.md` (`impstab schema --study`).
 """
+
+
+def unit(path: str) -> str | None:
+    """SI unit of the value at a parameter path (``mount_rings[0].k_shear`` -> ``"N/m"``);
+    ``"1"`` for a count, a flag or a word; None for an unknown path."""
+    import re
+
+    key = re.sub(r"\[\d+\](?=\.)", "[]", path)
+    key = re.sub(r"(\[\d+\])+$", "", key)
+    ref = MODEL_REFERENCE.get(key)
+    if ref is None:
+        return None
+    return ref.unit or "1"
 
 
 def label(path: str) -> str:
