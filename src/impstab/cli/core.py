@@ -161,6 +161,7 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
 @click.option("--all-crossings", is_flag=True, help="also list later losses and gains of stability")
 def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linearization: str | None, all_crossings: bool) -> None:
     """Critical thrust, kind, frequency and margin."""
+    from ..display.text import critical_rows
     from ..linear.critical_thrust import critical_thrust
 
     check_number("--thrust-max", thrust_max, positive=True)
@@ -170,7 +171,7 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
         print_json(res.to_dict())
         return
     t = table(f"critical thrust of {model.name}", "quantity", "value")
-    for name, value in critical_rows(res, model.is_damped):
+    for name, value in critical_rows(res, model.is_damped or model.fluid.compressible):
         t.add_row(name, value)
     for c in res.crossings:
         t.add_row(f"crossing ({c.direction})", f"{c.load:.10g} N, {c.kind}, {fmt(c.omega / (2 * np.pi))} Hz")
@@ -181,36 +182,6 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
     con.print(t)
     for w in res.warnings:
         con.print(f"[yellow]warning:[/yellow] {w}")
-
-
-def critical_rows(res, damped: bool) -> list[tuple[str, str]]:
-    """The rows of the ``critical`` table: every value with its unit, every gap explained."""
-    rows = []
-    if res.thrust is None:
-        rows.append(("critical thrust", f"none up to {res.thrust_max:g} N (stable over the whole range)"))
-    else:
-        rows.append(("critical thrust", _fmt(res.thrust, "N", 10)))
-        rows.append(("kind", res.kind))
-        rows.append(("frequency", f"{_fmt(res.frequency_hz)} Hz ({_fmt(res.omega)} rad/s)"))
-        rows.append(("modes involved", ", ".join(res.modes)))
-    rows.append(("operating thrust", _fmt(res.operating_thrust, "N", missing="not given (thrust.operating)")))
-    if res.margin is not None:
-        margin = _fmt(res.margin, "", 4)
-    elif res.operating_thrust is None:
-        margin = "needs an operating thrust"
-    else:
-        margin = f"> {res.thrust_max / res.operating_thrust:.4g} (stable up to thrust_max)"
-    rows.append(("margin (critical / operating)", margin))
-    if not damped and res.fluid_frequency_hz is None:
-        und = "same as the critical thrust (no dampers)"
-    elif res.undamped_thrust is None:
-        und = f"none up to {res.thrust_max:g} N (stable without damping)"
-    else:
-        und = f"{_fmt(res.undamped_thrust, 'N', 10)} ({res.undamped_kind})"
-    rows.append(("undamped critical thrust", und))
-    rows.append(("linearization", res.linearization))
-    rows.append(("search range", f"0 to {res.thrust_max:g} N"))
-    return rows
 
 
 commands = [check_cmd, modes_cmd, locus_cmd, critical_cmd]

@@ -162,17 +162,24 @@ class SimulationResult:
         return cls(**kw)
 
     def plot(self, ax=None):
-        """Sway (m) and pitch (rad) against time, like the paper's Figures 5-6; returns the axes."""
+        """Sway above pitch against time, like the paper's Figures 5-6.
+
+        ``ax`` may be None (a new figure), one Axes (sway only) or a pair; returns a
+        :class:`~impstab.plot.SimulationAxes` ``(sway, pitch)``, or the one Axes given.
+        """
         from ..plot.simulation import plot_simulation
 
         return plot_simulation(self, ax=ax)
 
     def __repr__(self) -> str:
-        g = self.growth
-        rate = "n/a" if g is None or not math.isfinite(g.rate) else f"{g.rate:.4g} 1/s"
-        state = "completed" if self.completed else f"stopped: {self.stop_reason}"
-        return (f"SimulationResult({self.model_name!r}, {self.integrator}, {self.thrust_history}, "
-                f"{self.time.size} samples, {state}, growth {rate}, {self.classification})")
+        from ..display import simulation_text
+
+        return simulation_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import simulation_html
+
+        return simulation_html(self)
 
 
 def combine_results(results) -> "xarray.Dataset":  # noqa: F821

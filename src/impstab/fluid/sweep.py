@@ -28,6 +28,11 @@ class FrequencySweep:
 
     points: tuple[FluidCoefficients, ...]
 
+    def __repr__(self) -> str:
+        from ..display import sweep_text
+
+        return sweep_text(self)
+
     def column(self, name: str) -> NDArray[np.float64]:
         """One coefficient against frequency as a float array (None becomes NaN)."""
         return np.array([_nan(getattr(p, name)) for p in self.points], dtype=float)

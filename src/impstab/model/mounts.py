@@ -60,6 +60,11 @@ class Mount:
     stiffness: Array
     damping: Array
 
+    def __repr__(self) -> str:
+        from ..display import mount_text
+
+        return mount_text(self)
+
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", _frozen(self.position))
         object.__setattr__(self, "stiffness", _frozen(self.stiffness))

@@ -32,6 +32,16 @@ class StudyResult:
     dataset: Any
     store: str | None = None
 
+    def __repr__(self) -> str:
+        from ..display import study_text
+
+        return study_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import study_html
+
+        return study_html(self)
+
     def __post_init__(self) -> None:
         # parameter coordinates carry the units of their model-file keys
         from ..model.reference import label, unit

@@ -49,6 +49,11 @@ class Parameter:
     path: ParameterPath
     values: NDArray
 
+    def __repr__(self) -> str:
+        from ..display import parameter_text
+
+        return parameter_text(self)
+
     @property
     def name(self) -> str:
         """The path as written in the study file (also the name of its coordinate)."""
@@ -72,6 +77,11 @@ class Study:
     source: str | None = None
     model_source: str | None = None
     seed: int = 0
+
+    def __repr__(self) -> str:
+        from ..display import study_definition_text
+
+        return study_definition_text(self)
 
     @property
     def dims(self) -> tuple[str, ...]:
