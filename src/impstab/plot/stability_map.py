@@ -174,6 +174,9 @@ def plot_stability_map(result, ax=None, *, x: str | None = None, y: str | None =
         censored_text = f"stable up to {_limit_text(result, value)}, censored"
         if "sample" in ds.dims:
             handles = _points(ax, ds, x, y, value, kind, status, censored_text)
+            others = [_label(p) for p in result.parameters if p not in (x, y)]
+            if others:
+                fixed = [f"projection: {', '.join(others)} also var{'ies' if len(others) == 1 else 'y'}"]
         elif y is None:
             handles = _curve(ax, ds, x, value, kind, status, censored_text)
         else:

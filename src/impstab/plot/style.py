@@ -27,7 +27,7 @@ STYLE = {
     "axes.spines.top": False,
     "axes.spines.right": False,
     "axes.formatter.useoffset": False,      # no offset labels that collide with titles
-    "axes.formatter.limits": (-4, 5),
+    "axes.formatter.limits": (-5, 7),       # plain numbers from 1e-5 to 1e7: no "x 10^5" label
     "axes.formatter.use_mathtext": True,
     "lines.linewidth": 1.4,
     "image.cmap": "viridis",
