@@ -136,14 +136,16 @@ def simulation_html(r) -> str:
 
 
 def study_html(s) -> str:
-    from ..model.reference import label
+    from ..model.reference import label, unit
 
     ds = s.dataset
     rows = [("study", ds.attrs.get("study_name", "")), ("sampling", ds.attrs.get("sampling", "")),
             ("designs", f"{int(ds['status'].size)}: " + ", ".join(f"{k} {v}" for k, v in s.counts().items() if v))]
     for p in s.parameters:
         v = np.asarray(ds[p].values)
-        span = f"{number(v.min())} to {number(v.max())}" if v.dtype.kind in "fiu" else ", ".join(map(str, v[:6]))
+        u = unit(p)
+        u = "" if u in (None, "1") else f" {u}"
+        span = f"{number(v.min())} to {number(v.max())}{u}" if v.dtype.kind in "fiu" else ", ".join(map(str, v[:6]))
         rows.append((f"parameter {p}", f"{label(p)}: {v.size} values, {span}"))
     if "kind" in ds:
         names = s.kind_names().values.ravel()
