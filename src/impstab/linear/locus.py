@@ -371,7 +371,7 @@ def matching_order(ref: NDArray[np.complex128], lam: NDArray[np.complex128]) -> 
 
 def _conjugate_groups(lam: NDArray[np.complex128]) -> list[NDArray[np.int64]]:
     """Columns of a tracked set that form one mode: linked where one is the conjugate of another."""
-    count, k = lam.shape
+    k = lam.shape[1]
     label = np.arange(k)
 
     def root(i):
@@ -380,16 +380,16 @@ def _conjugate_groups(lam: NDArray[np.complex128]) -> list[NDArray[np.int64]]:
         return i
 
     scale = max(float(np.nanmax(np.abs(lam))) if lam.size else 1.0, 1e-300)
-    for i in range(count):
-        row = lam[i]
-        for a in range(k):
-            if not row[a].imag > _PAIR_TOL * scale:
-                continue
-            dist = np.abs(row - np.conj(row[a]))
-            b = int(np.argmin(dist))
-            if b != a and dist[b] <= _PAIR_TOL * scale:
-                ra, rb = root(a), root(b)
-                if ra != rb:
-                    label[max(ra, rb)] = min(ra, rb)
+    with np.errstate(invalid="ignore"):
+        dist = np.abs(lam[:, :, None] - np.conj(lam)[:, None, :])  # (rows, a, b)
+        partner = np.argmin(np.where(np.isnan(dist), np.inf, dist), axis=-1)
+        near = np.take_along_axis(dist, partner[..., None], axis=-1)[..., 0] <= _PAIR_TOL * scale
+        upper = lam.imag > _PAIR_TOL * scale
+    first = np.broadcast_to(np.arange(k), partner.shape)
+    linked = upper & near & (partner != first)
+    for a, b in set(zip(first[linked].tolist(), partner[linked].tolist())):
+        ra, rb = root(a), root(b)
+        if ra != rb:
+            label[max(ra, rb)] = min(ra, rb)
     roots = np.array([root(i) for i in range(k)])
     return [np.flatnonzero(roots == r) for r in np.unique(roots)]
