@@ -180,3 +180,35 @@ def test_speed_rpm_is_the_speed_in_revolutions_per_minute():
 ])
 def test_axis_labels_come_from_the_reference(path, label):
     assert model_ref.label(path) == label
+
+
+def test_walker_documents_nested_tables_of_array_entries():
+    """A table inside each entry of an array of tables (the shape of ``[mounts.beam]``)."""
+    from typing import Annotated, Literal, Optional
+
+    from pydantic import BaseModel, ConfigDict, Field, StrictFloat
+
+    from impstab.model.schema_doc import RefEntry, allowed_keys, markdown
+
+    class _S(BaseModel):
+        model_config = ConfigDict(extra="forbid")
+
+    class Beam(_S):
+        length: Annotated[StrictFloat, Field(gt=0, allow_inf_nan=False)]
+        law: Literal["a", "b"] = "a"
+
+    class Mount(_S):
+        position: Annotated[list[Annotated[float, Field(allow_inf_nan=False)]], Field(min_length=3, max_length=3)]
+        beam: Optional[Beam] = None
+
+    class File(_S):
+        mounts: list[Mount] = []
+
+    keys = {k.path: k for k in walk(File)}
+    assert list(keys) == ["mounts", "mounts[].position", "mounts[].beam", "mounts[].beam.length", "mounts[].beam.law"]
+    assert keys["mounts[].beam.length"].section == "[mounts.beam]" and keys["mounts[].beam"].kind == "table"
+    assert keys["mounts[].beam.length"].rule == "> 0, finite" and keys["mounts[].beam.length"].required
+    assert keys["mounts[].position"].type == "3 numbers" and keys["mounts[].beam.law"].default == '"a"'
+    assert allowed_keys(File, ("mounts", 0, "beam")) == ["length", "law"]
+    table = {p: RefEntry("m" if "length" in p else "", f"about {p}") for p in keys}
+    assert "## `[mounts.beam]`" in markdown(File, table, title="t", intro="i")
