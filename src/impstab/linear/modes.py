@@ -54,6 +54,16 @@ class ModalResult:
     shapes: NDArray[np.complex128]
     participation: NDArray[np.float64]
 
+    def __repr__(self) -> str:
+        from ..display import modal_text
+
+        return modal_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import modal_html
+
+        return modal_html(self)
+
     @property
     def omega(self) -> NDArray[np.float64]:
         """Damped angular frequency (rad/s)."""

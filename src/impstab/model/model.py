@@ -59,6 +59,16 @@ class Model:
     excitation: Excitation = field(default_factory=Excitation)
     foundation: Foundation = field(default_factory=Foundation)
 
+    def __repr__(self) -> str:
+        from ..display import model_text
+
+        return model_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import model_html
+
+        return model_html(self)
+
     def __post_init__(self) -> None:
         object.__setattr__(self, "mounts", tuple(self.mounts))
 

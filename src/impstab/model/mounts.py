@@ -69,6 +69,11 @@ class Mount:
     rated_force: float | None = None
     max_deflection: float | None = None
 
+    def __repr__(self) -> str:
+        from ..display import mount_text
+
+        return mount_text(self)
+
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", _frozen(self.position))
         object.__setattr__(self, "stiffness", _frozen(self.stiffness))

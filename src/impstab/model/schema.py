@@ -85,6 +85,7 @@ class ThrustSpec(_Strict):
 class PropellerSpec(_Strict):
     polar_inertia: NonNegative = 0.0
     speed: Finite = 0.0
+    speed_rpm: Optional[Finite] = None  # rpm, instead of speed (rad/s)
     speed_law: Literal["constant", "sqrt-thrust"] = "constant"
 
 
