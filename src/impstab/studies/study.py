@@ -22,8 +22,10 @@ from pydantic import ValidationError
 
 from ..errors import ModelError
 from ..limits import MAX_STUDY_BYTES
-from ..model.assemble import _plain_loc, check_nesting, format_location, model_from_dict, parse_toml, read_text, rule_text
+from ..model.assemble import _error_loc, check_nesting, format_location, model_from_dict, parse_toml, read_text, rule_text
+from ..model.schema_doc import unknown_key_rule
 from .paths import ParameterPath, resolve_path
+from .reference import DOC_PATH as STUDY_DOC_PATH
 from .sampling import axis_values, check_distribution, map_samples, unit_samples
 from .schema import VALUES_TAGS, ParameterSpec, RangeSpec, StudyFile
 
@@ -52,6 +54,11 @@ class Parameter:
     path: ParameterPath
     values: NDArray
 
+    def __repr__(self) -> str:
+        from ..display import parameter_text
+
+        return parameter_text(self)
+
     @property
     def name(self) -> str:
         """The path as written in the study file (also the name of its coordinate)."""
@@ -76,6 +83,11 @@ class Study:
     model_source: str | None = None
     seed: int = 0
 
+    def __repr__(self) -> str:
+        from ..display import study_definition_text
+
+        return study_definition_text(self)
+
     @property
     def dims(self) -> tuple[str, ...]:
         """Dimensions of the results: one per parameter for a grid, else ``("sample",)``."""
@@ -99,14 +111,17 @@ def _shown(value: Any) -> Any:
 
 
 def _schema_error(err: ValidationError) -> ModelError:
-    first = err.errors()[0]
-    loc = tuple(p for p in _plain_loc(first["loc"]) if not (isinstance(p, str) and ("[" in p or p in VALUES_TAGS)))
+    errors = err.errors()
+    # an unknown key is a typo: report it first (pydantic lists the key it hides as missing first)
+    first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
+    loc = tuple(p for p in _error_loc(StudyFile, first) if p not in VALUES_TAGS)
     field = format_location(loc)
     kind = first["type"]
     if kind == "extra_forbidden":
-        return ModelError(field, first.get("input"), "unknown key (check the spelling against the study-file schema)")
+        where = f"in {format_location(loc[:-1])}" if len(loc) > 1 else "at the top level"
+        return ModelError(field, first.get("input"), unknown_key_rule(StudyFile, loc, where, STUDY_DOC_PATH))
     if kind == "missing":
-        return ModelError(field, None, "is required")
+        return ModelError(field, None, f"is required (see {STUDY_DOC_PATH})")
     return ModelError(field, first.get("input"), rule_text(first))
 
 
