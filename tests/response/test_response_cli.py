@@ -1,6 +1,7 @@
 """``impstab response`` and the isolation additions of ``check`` and ``modes`` end to end."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -110,7 +111,7 @@ def test_modes_prints_the_decoupling_table_and_the_axes(capsys, examples):
 
 def test_check_reports_static_mount_loads_and_overloads(capsys, examples, tmp_path):
     code, out, _ = run(capsys, "check", examples / "imp_isolation.toml")
-    assert code == 0 and "static mount deflection and load" in out and "83 %" in out
+    assert code == 0 and "static mount deflection and load" in out and re.search(r" 83 *$", out, re.M)
     text = (examples / "imp_isolation.toml").read_text().replace("rated_force = 1000.0", "rated_force = 500.0")
     p = tmp_path / "over.toml"
     p.write_text(text)

@@ -118,21 +118,27 @@ def _static_loads_table(model, con) -> None:
         con.print(f"[yellow]warning:[/yellow] static mount loads at the operating thrust: {user_text(exc)}")
         return
     t = table(f"static mount deflection and load at the operating thrust {st.thrust:g} N ({st.linearization})",
-              ("mount", "right"), "position (m)", ("axial d (mm)", "right"), ("shear d (mm)", "right"),
-              ("|d| (mm)", "right"), ("axial F (N)", "right"), ("shear F (N)", "right"), ("|F| (N)", "right"),
-              ("utilisation", "right"))
+              ("mount", "right"), ("axial d (mm)", "right"), ("shear d (mm)", "right"), ("|d| (mm)", "right"),
+              ("axial F (N)", "right"), ("shear F (N)", "right"), ("|F| (N)", "right"), ("use (%)", "right"))
     util = st.utilisation
-    for i, m in enumerate(model.mounts):
+
+    def part(value: float, whole: float, scale: float, digits: int) -> str:
+        # a component at rounding level of the whole (a shear of 1e-16 mm on an axial mount) is 0
+        return _fmt(0.0 if abs(value) <= 1e-9 * abs(whole) else scale * value, digits=digits)
+
+    for i in range(len(model.mounts)):
         u = "no rating" if not np.isfinite(util[i]) else (
-            f"[red]{100 * util[i]:.0f} %[/red]" if util[i] > 1 else f"{100 * util[i]:.0f} %")
+            f"[red]{100 * util[i]:.0f}[/red]" if util[i] > 1 else f"{100 * util[i]:.0f}")
+        dm, fm = st.deflection_magnitude[i], st.force_magnitude[i]
         t.add_row(
-            str(i), _vec(np.round(m.position, 4), "").strip(), _fmt(1e3 * st.axial_deflection[i], digits=4),
-            _fmt(1e3 * st.shear_deflection[i], digits=4), _fmt(1e3 * st.deflection_magnitude[i], digits=4),
-            _fmt(st.axial_force[i], digits=5), _fmt(st.shear_force[i], digits=5), _fmt(st.force_magnitude[i], digits=5), u,
+            str(i), part(st.axial_deflection[i], dm, 1e3, 4), part(st.shear_deflection[i], dm, 1e3, 4),
+            _fmt(1e3 * dm, digits=4), part(st.axial_force[i], fm, 1.0, 5), part(st.shear_force[i], fm, 1.0, 5),
+            _fmt(fm, digits=5), u,
         )
     con.print(t)
-    con.print("d: body-end deflection of the attachment from the unloaded pose; F: force of the mount on the hull; "
-              "utilisation: the larger of |F| / rated_force and |d| / max_deflection (no rating: neither key given)")
+    con.print("mounts numbered as in `impstab check` above; d: body-end deflection of the attachment from the "
+              "unloaded pose; F: force of the mount on the hull; use: the larger of |F| / rated_force and "
+              "|d| / max_deflection (no rating: neither key given)")
     for w in st.warnings:
         con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
 
@@ -173,7 +179,7 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
                   growth(res.growth_rate[j], scale), "/".join(dom))
     con = console()
     con.print(t)
-    e = table("decoupling table: kinetic energy of each mode by dof (%)", ("mode", "right"),
+    e = table("decoupling table: kinetic-energy shares of each mode by dof (%)", ("mode", "right"),
               *((n, "right") for n in DOF_NAMES))
     for j in range(len(res.eigenvalues)):
         e.add_row(str(j + 1), *(f"{round(100 * v, 1) + 0.0:.1f}" for v in res.participation[j]))

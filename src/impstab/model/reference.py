@@ -66,6 +66,10 @@ MODEL_REFERENCE: dict[str, E] = {
                             "instead of k_axial and k_shear."),
     "mounts[].damping": E("N s/m, N s/rad, N m s/m, N m s/rad by block", "Full 6 x 6 viscous damping of the body end, "
                           "same layout; symmetric, positive semi-definite; instead of c_axial and c_shear."),
+    "mounts[].rated_force": E("N", "Static force rating of the mount: `impstab check` reports |F| / rated_force at "
+                              "the operating thrust and warns above 1.", "mount rated force"),
+    "mounts[].max_deflection": E("m", "Static deflection limit of the mount: `impstab check` reports |d| / "
+                                 "max_deflection at the operating thrust and warns above 1.", "mount deflection limit"),
     # [[mount_rings]]
     "mount_rings": E("", "Rings of identical mounts, equally spaced around the axis (count mounts on a circle of "
                      "the given radius in the plane at x)."),
@@ -78,6 +82,9 @@ MODEL_REFERENCE: dict[str, E] = {
     "mount_rings[].k_shear": E("N/m", "Shear stiffness of each mount.", "mount shear stiffness k_shear"),
     "mount_rings[].c_axial": E("N s/m", "Axial viscous damping of each mount.", "mount axial damping c_axial"),
     "mount_rings[].c_shear": E("N s/m", "Shear viscous damping of each mount.", "mount shear damping c_shear"),
+    "mount_rings[].rated_force": E("N", "Static force rating of each mount of the ring.", "mount rated force"),
+    "mount_rings[].max_deflection": E("m", "Static deflection limit of each mount of the ring.",
+                                      "mount deflection limit"),
     # [thrust]
     "thrust": E("", "The thrust: a force of magnitude T (the load parameter) along the propulsor's own axis."),
     "thrust.point": E("m", "Point of application, body frame, from A.", "thrust point"),
@@ -104,6 +111,56 @@ MODEL_REFERENCE: dict[str, E] = {
                              "(required when no operating thrust is given).", "thrust_max"),
     "analysis.linearization": E("", "\"equilibrium\": the tangent at the nonlinear static equilibrium under thrust; "
                                 "\"classical\": at the undeformed configuration (the paper's eq. 21)."),
+    # [excitation]
+    "excitation": E("", "Operating excitation for the forced response (`impstab response --excitation`); "
+                    "see docs/isolation.md."),
+    "excitation.input": E("", "Dof of the unit load of `impstab response` when --input is not given "
+                          "(surge, sway, heave, roll, pitch or yaw).", "input dof"),
+    "excitation.unbalance": E("", "Rotating unbalances at shaft rate; need propeller.speed (or speed_rpm) not 0."),
+    "excitation.unbalance[].mass": E("kg", "Unbalance mass m.", "unbalance mass"),
+    "excitation.unbalance[].eccentricity": E("m", "Radius e of the unbalance mass: a force m e Omega^2 rotating "
+                                             "at shaft rate Omega (the propeller speed law) in the plane normal "
+                                             "to the thrust axis.", "unbalance eccentricity"),
+    "excitation.unbalance[].point": E("m", "Where the unbalance force acts, body frame, from A; default "
+                                      "thrust.point.", "unbalance point"),
+    "excitation.unbalance[].phase_deg": E("deg", "Angle of the unbalance at t = 0 in the plane normal to the "
+                                          "thrust axis.", "unbalance phase"),
+    "excitation.blade_rate": E("", "Blade-rate forces and moments (harmonic x blades x shaft rate); need "
+                               "propeller.speed (or speed_rpm) not 0."),
+    "excitation.blade_rate[].blades": E("", "Blade count Z (an integer).", "blade count"),
+    "excitation.blade_rate[].harmonic": E("", "Harmonic of the blade rate (an integer): the frequency is "
+                                          "harmonic * Z * |Omega| / 2 pi.", "blade-rate harmonic"),
+    "excitation.blade_rate[].amplitude": E("N, N m by component", "Amplitudes of the force and moment at "
+                                           "`point`, body axes, dof order surge ... yaw (magnitudes).",
+                                           "blade-rate amplitude"),
+    "excitation.blade_rate[].phase_deg": E("deg", "Phase of each of the six components.", "blade-rate phase"),
+    "excitation.blade_rate[].point": E("m", "Where the blade-rate load acts, body frame, from A; default "
+                                       "thrust.point.", "blade-rate point"),
+    "excitation.spectrum": E("", "A table of harmonic lines (a measured or specified spectrum)."),
+    "excitation.spectrum.frequency_hz": E("Hz", "Frequency of each line.", "spectrum frequency"),
+    "excitation.spectrum.amplitude": E("N, N m by component", "One row of six amplitudes (force and moment at "
+                                       "`point`, body axes) per frequency.", "spectrum amplitude"),
+    "excitation.spectrum.phase_deg": E("deg", "Phases, same shape as amplitude; default 0.", "spectrum phase"),
+    "excitation.spectrum.point": E("m", "Where the spectrum's loads act, body frame, from A.", "spectrum point"),
+    # [foundation]
+    "foundation": E("", "The hull at every mount attachment for the forced response: rigid (default) or an "
+                    "isotropic point impedance per attachment, uncoupled between attachments."),
+    "foundation.model": E("", "\"rigid\"; \"lumped\" (Z = damping + i (omega mass - stiffness / omega)); "
+                          "\"mobility-table\" or \"impedance-table\" (tables against frequency_hz, linear "
+                          "interpolation)."),
+    "foundation.mass": E("kg", "Lumped hull mass at each attachment (lumped).", "foundation mass"),
+    "foundation.stiffness": E("N/m", "Lumped hull stiffness at each attachment (lumped).", "foundation stiffness"),
+    "foundation.damping": E("N s/m", "Lumped hull damping at each attachment (lumped).", "foundation damping"),
+    "foundation.frequency_hz": E("Hz", "Frequencies of the table (at least 2, strictly increasing); analysed "
+                                 "frequencies must lie inside it.", "foundation table frequency"),
+    "foundation.mobility_real": E("m/(N s)", "Real part of the point mobility (>= 0: a passive hull) "
+                                  "(mobility-table).", "foundation mobility (real)"),
+    "foundation.mobility_imag": E("m/(N s)", "Imaginary part of the point mobility (mobility-table).",
+                                  "foundation mobility (imaginary)"),
+    "foundation.impedance_real": E("N s/m", "Real part of the point impedance (>= 0) (impedance-table).",
+                                   "foundation impedance (real)"),
+    "foundation.impedance_imag": E("N s/m", "Imaginary part of the point impedance (impedance-table).",
+                                   "foundation impedance (imaginary)"),
 }
 
 INTRO = f"""
