@@ -44,16 +44,21 @@ def _options(command: str):
                                                           "0:10:0", "0:1e5:10000", "5:5:1", "0:1e7:2"])), ("-o", "OUT")],
         "sweep": [("-o", "OUT"), ("--workers", st.sampled_from(["0", "-1", "100000", "x"])), ("--export", "OUT")],
         "map": [("--x", st.sampled_from(["mount_rings[0].x", "nope", "\x1b[2J"])), ("-o", "OUT")],
+        "response": [("--thrust", numbers), ("--input", st.sampled_from(["sway", "twist", "\x1b[2J"])), ("--json",),
+                     ("--excitation",), ("-o", "OUT")],
     }
     return common[command]
 
 
 @st.composite
 def command_lines(draw):
-    command = draw(st.sampled_from(["check", "critical", "modes", "locus", "simulate", "added-mass", "sweep", "map"]))
+    command = draw(st.sampled_from(["check", "critical", "modes", "locus", "simulate", "added-mass", "sweep", "map",
+                                    "response"]))
     argv = [command]
-    if command in ("check", "critical", "modes", "locus", "simulate"):
+    if command in ("check", "critical", "modes", "locus", "simulate", "response"):
         argv.append(draw(st.sampled_from(MODELS)))
+    if command == "response":
+        argv += ["--frequencies", draw(st.sampled_from(["0:20:5", "0:1:1e9", "0:1e7:3", "5:1:2", "x", "0:100:100001"]))]
     if command == "simulate":
         argv += ["--thrust", draw(st.sampled_from(["1000", "0", "-1", "nan", "1e308", "1e9"])),
                  "--duration", draw(st.sampled_from(["0.05", "1e9", "1e6", "0", "-1", "nan", "1e-300", "abc"]))]
@@ -88,7 +93,7 @@ def _files(folder: Path) -> dict[str, str]:
             "STUDY": str(study)}
 
 
-OUTPUTS = {"locus": "l.nc", "simulate": "s.nc", "added-mass": "a.png", "sweep": "s.zarr", "map": "m.png"}
+OUTPUTS = {"locus": "l.nc", "simulate": "s.nc", "added-mass": "a.png", "sweep": "s.zarr", "map": "m.png", "response": "r.nc"}
 
 
 @fuzz(60)

@@ -17,7 +17,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 BASES = [ring_model_dict(), asymmetric_model_dict()] + [
-    tomllib.loads((EXAMPLES / name).read_text()) for name in ("imp_damped.toml", "imp_fluid.toml", "imp_asymmetric.toml")
+    tomllib.loads((EXAMPLES / name).read_text())
+    for name in ("imp_damped.toml", "imp_fluid.toml", "imp_asymmetric.toml", "imp_isolation.toml")
 ]
 
 
@@ -46,7 +47,7 @@ def test_broken_model_files(doc):
 
 
 @fuzz(15)
-@given(doc=mutated(BASES, gentle=True), command=st.sampled_from(["modes", "locus", "critical-text"]))
+@given(doc=mutated(BASES, gentle=True), command=st.sampled_from(["modes", "locus", "critical-text", "response"]))
 def test_valid_model_files(doc, command):
     with tempfile.TemporaryDirectory() as tmp:
         path = _write(doc, Path(tmp))
@@ -64,6 +65,9 @@ def test_valid_model_files(doc, command):
         elif command == "locus":
             code, stdout, stderr = run_cli("locus", str(path), "--steps", "6", "-o", str(out / "l.nc"))
             check_run(code, stdout, stderr, out, expected=("l.nc", "l.png"))
+        elif command == "response":
+            code, stdout, stderr = run_cli("response", str(path), "--frequencies", "0:30:7", "--json")
+            check_run(code, stdout, stderr, out, as_json=True)
         else:
             code, stdout, stderr = run_cli("critical", str(path), "--all-crossings")
             check_run(code, stdout, stderr, out)
