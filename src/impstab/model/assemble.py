@@ -23,7 +23,7 @@ from .fluid import FluidLoading, Hull
 from .model import AnalysisSettings, Model
 from .mounts import Mount, axial_shear_matrix, elastic_stiffness, ring_positions
 from .reference import DOC_PATH
-from .schema import UNION_TAGS, ModelFile
+from .schema import UNION_TAGS, ModelFile, mark_at
 from .schema_doc import clean_loc, unknown_key_rule
 from .thrust import Propeller, Thrust
 
@@ -99,13 +99,24 @@ def _from_validation_error(err: ValidationError, data: Any) -> ModelError:
         return ModelError(field, value, unknown_key_rule(ModelFile, loc, where, DOC_PATH))
     if kind == "missing":
         return ModelError(field, None, f"is required (see {DOC_PATH})")
-    return ModelError(field, value, rule_text(first))
+    return ModelError(field, value, rule_text(first, mark_at(ModelFile, tuple(first["loc"]))))
 
 
-def rule_text(error: dict) -> str:
-    """The rule of one pydantic error in the words of the file (``must be a list``)."""
+#: errors of a marked value, worded by its mark (range, unit, what it is)
+_MARKED = frozenset(("float_type", "finite_number", "greater_than_equal", "less_than_equal", "greater_than",
+                     "less_than", "int_type", "int_from_float", "int_parsing", "bool_type", "bool_parsing"))
+
+
+def rule_text(error: dict, mark: Any = None) -> str:
+    """The rule of one pydantic error in the words of the file (``must be a list``).
+
+    ``mark``: the :class:`~impstab.model.schema.RangeMark` (or integer or flag mark) of the value,
+    which words a wrong type or a value out of range with the range, its unit and its meaning.
+    """
     kind = error["type"]
     ctx = error.get("ctx") or {}
+    if mark is not None and kind in _MARKED:
+        return mark.rule(error.get("input"))
     if kind in _TYPE_RULES:
         return _TYPE_RULES[kind]
     if kind in ("too_short", "too_long") and "actual_length" in ctx:

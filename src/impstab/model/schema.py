@@ -14,27 +14,81 @@ are checked when the validated file is assembled into a :class:`~impstab.model.M
 
 from __future__ import annotations
 
+import types
+import typing
 from typing import Annotated, Any, Literal, Optional, Union
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Discriminator, Field, Tag, field_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator
 
 from ..limits import MAX_MOUNTS, MAX_TEXT, RANGES, as_boolean, as_integer
 
-__all__ = ["ModelFile", "MountSpec", "MountRingSpec", "number", "integer", "UNION_TAGS"]
+__all__ = ["ModelFile", "MountSpec", "MountRingSpec", "number", "integer", "mark_at", "RangeMark", "UNION_TAGS"]
+
+
+class RangeMark:
+    """Marks a number of the schema with its range of :data:`impstab.limits.RANGES`.
+
+    Validation itself runs in pydantic-core (strict float, ``ge``/``le``, no inf/nan: no Python
+    call per number); the mark only words a failure: :func:`impstab.model.assemble.rule_text`
+    finds it at the error's location and names the range, its unit and what it is.
+    """
+
+    __slots__ = ("kind",)
+
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+
+    def rule(self, value: object) -> str:
+        try:
+            RANGES[self.kind].validate(value)
+        except ValueError as exc:
+            return str(exc)
+        return RANGES[self.kind].rule()
+
+
+class IntegerMark:
+    """Marks an integer of the schema with its range and meaning (see :class:`RangeMark`)."""
+
+    __slots__ = ("low", "high", "what")
+
+    def __init__(self, low: int | None = None, high: int | None = None, what: str = "") -> None:
+        self.low, self.high, self.what = low, high, what
+
+    def rule(self, value: object) -> str:
+        try:
+            n = as_integer(value)
+        except ValueError as exc:
+            return str(exc)
+        if self.low is not None and self.high is not None:
+            return f"must be an integer between {self.low} and {self.high} ({self.what})"
+        return f"must be an integer (not {n})"
+
+
+class FlagMark:
+    """Marks a flag of the schema (see :class:`RangeMark`)."""
+
+    __slots__ = ()
+
+    def rule(self, value: object) -> str:
+        try:
+            as_boolean(value)
+        except ValueError as exc:
+            return str(exc)
+        return "must be true or false"
 
 
 def number(kind: str) -> Any:
     """A strict float in the range ``RANGES[kind]`` (integers are numbers; booleans, strings are not)."""
     r = RANGES[kind]
-    return Annotated[float, Field(ge=r.low, le=r.high, strict=True, allow_inf_nan=False), BeforeValidator(r.validate)]
+    return Annotated[float, Field(ge=r.low, le=r.high, strict=True, allow_inf_nan=False), RangeMark(kind)]
 
 
 # -- the type aliases every key uses (strict, ranged) ------------------------------------------
 Finite = number("number")                 # any finite number within +-1e15
 Positive = number("positive")             # 1e-12 ... 1e15
 NonNegative = number("nonnegative")       # 0 ... 1e15
-Integer = Annotated[int, Field(strict=True), BeforeValidator(as_integer)]  # 3, never 3.0 or true
-Flag = Annotated[bool, Field(strict=True), BeforeValidator(as_boolean)]
+Integer = Annotated[int, Field(strict=True), IntegerMark()]  # 3, never 3.0 or true
+Flag = Annotated[bool, Field(strict=True), FlagMark()]
 Text = Annotated[str, Field(strict=True, max_length=MAX_TEXT)]
 StrictFloat, StrictInt, StrictBool = Finite, Integer, Flag
 
@@ -42,14 +96,60 @@ StrictFloat, StrictInt, StrictBool = Finite, Integer, Flag
 
 def integer(low: int, high: int, what: str) -> Any:
     """A strict integer in ``[low, high]`` (``3.0``, ``true`` and ``"3"`` are not integers)."""
+    return Annotated[int, Field(ge=low, le=high, strict=True), IntegerMark(low, high, what)]
 
-    def check(value: object) -> int:
-        n = as_integer(value)
-        if not (low <= n <= high):
-            raise ValueError(f"must be an integer between {low} and {high} ({what})")
-        return n
 
-    return Annotated[int, Field(ge=low, le=high, strict=True), BeforeValidator(check)]
+def mark_at(root: type[BaseModel], loc: tuple) -> Any:
+    """The :class:`RangeMark`, :class:`IntegerMark` or :class:`FlagMark` of the value at ``loc``
+    (a pydantic error location: keys, list indices, union labels and tags), or None."""
+    tp: Any = root
+    for part in loc:
+        core, _ = _strip(tp)
+        if isinstance(part, int):
+            core = _list_branch(core)
+            if typing.get_origin(core) is not list:
+                return None
+            tp = typing.get_args(core)[0]
+        elif isinstance(core, type) and issubclass(core, BaseModel):
+            info = core.model_fields.get(part)
+            if info is None:
+                return None
+            tp = Annotated[(info.annotation, *info.metadata)] if info.metadata else info.annotation
+        elif typing.get_origin(core) in (Union, types.UnionType):
+            tagged = [a for a in typing.get_args(core) if any(isinstance(m, Tag) and m.tag == part for m in _strip(a)[1])]
+            if tagged:
+                tp = tagged[0]
+            # else: a label pydantic inserts for a union branch ("list[float]"): the index that
+            # follows picks the list branch
+        # else: a label on a plain value (a validator's name): nothing to descend into
+    _, meta = _strip(tp)
+    return next((m for m in meta if isinstance(m, (RangeMark, IntegerMark, FlagMark))), None)
+
+
+def _strip(tp: Any) -> tuple[Any, list]:
+    """Remove ``Optional`` and ``Annotated`` wrappers; returns the core type and the metadata."""
+    meta: list = []
+    while True:
+        origin = typing.get_origin(tp)
+        if origin is Annotated:
+            meta.extend(tp.__metadata__)
+            tp = tp.__origin__
+        elif origin in (Union, types.UnionType):
+            args = [a for a in typing.get_args(tp) if a is not type(None)]
+            if len(args) != 1:
+                return tp, meta
+            tp = args[0]
+        else:
+            return tp, meta
+
+
+def _list_branch(core: Any) -> Any:
+    if typing.get_origin(core) in (Union, types.UnionType):
+        for arg in typing.get_args(core):
+            inner, _ = _strip(arg)
+            if typing.get_origin(inner) is list:
+                return inner
+    return core
 
 
 # physical magnitudes (SI units; ranges and reasons in docs/limits.md)

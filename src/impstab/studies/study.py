@@ -23,6 +23,7 @@ from pydantic import ValidationError
 from ..errors import ModelError
 from ..limits import MAX_STUDY_BYTES
 from ..model.assemble import _error_loc, check_nesting, format_location, model_from_dict, parse_toml, read_text, rule_text
+from ..model.schema import mark_at
 from ..model.schema_doc import unknown_key_rule
 from .paths import ParameterPath, resolve_path
 from .reference import DOC_PATH as STUDY_DOC_PATH
@@ -122,7 +123,7 @@ def _schema_error(err: ValidationError) -> ModelError:
         return ModelError(field, first.get("input"), unknown_key_rule(StudyFile, loc, where, STUDY_DOC_PATH))
     if kind == "missing":
         return ModelError(field, None, f"is required (see {STUDY_DOC_PATH})")
-    return ModelError(field, first.get("input"), rule_text(first))
+    return ModelError(field, first.get("input"), rule_text(first, mark_at(StudyFile, tuple(first["loc"]))))
 
 
 def result_bytes(n_designs: int, n_parameters: int, outputs: tuple[str, ...] | list[str], grid: bool) -> int:
