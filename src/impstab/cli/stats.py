@@ -43,12 +43,12 @@ def _sensitivity_table(ind):
     from rich import box
     from rich.table import Table
 
-    t = Table(box=box.SIMPLE_HEAD, title=f"Sobol indices of {ind.of}, +- {100 * ind.confidence:g} % "
-              "bootstrap intervals", title_justify="left")
+    t = Table(box=box.SIMPLE_HEAD, title=f"Sobol indices of {ind.of}", title_justify="left")
+    conf = f"{100 * ind.confidence:g} %"
     t.add_column("parameter")
-    t.add_column("first order", justify="right")
+    t.add_column(f"first order +- {conf}", justify="right")
     if ind.total_order is not None:
-        t.add_column("total", justify="right")
+        t.add_column(f"total +- {conf}", justify="right")
     for i, p in enumerate(ind.parameters):
         row = [p, f"{ind.first_order[i]:.3f} +- {ind.first_order_conf[i]:.3f}"]
         if ind.total_order is not None:
@@ -81,15 +81,16 @@ def _save(ax, out: Path, dpi: float | None) -> None:
 
 @click.command("stats")
 @click.argument("store", type=click.Path())
-@click.option("--target-margin", type=float, default=1.0, show_default=True,
-              help="required margin (critical / operating thrust): the probability of a margin below it")
+@click.option("--target-margin", type=float, default=None,
+              help="required margin (critical / operating thrust): the probability of a margin below it "
+                   "(default 1, when thrust_max reaches the operating thrust)")
 @click.option("--confidence", type=float, default=0.95, show_default=True, help="level of every interval and band")
 @click.option("--no-sensitivity", is_flag=True, default=False, help="leave out the Sobol sensitivity indices")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object (units in docs/studies.md)")
 @click.option("-o", "--output", default=None, type=click.Path(dir_okay=False),
               help="figure (.png, .svg or .pdf): histogram, ECDF with its band, sensitivity indices")
 @click.option("--dpi", type=float, default=None, help="resolution of a PNG figure (default 150)")
-def stats_cmd(store: str, target_margin: float, confidence: float, no_sensitivity: bool, as_json: bool,
+def stats_cmd(store: str, target_margin: float | None, confidence: float, no_sensitivity: bool, as_json: bool,
               output: str | None, dpi: float | None) -> None:
     """Distribution of the critical thrust and margin, probability of missing a required margin
     and Sobol indices of the random, Sobol or Saltelli study in STORE."""
@@ -104,7 +105,13 @@ def stats_cmd(store: str, target_margin: float, confidence: float, no_sensitivit
     if dpi is not None and not (math.isfinite(dpi) and 1 <= dpi <= 2400):
         raise ModelError("--dpi", dpi, "must be between 1 and 2400")
     res = open_study(store)
-    stats = study_statistics(res, target_margin, confidence=confidence, sensitivity=not no_sensitivity)
+    kw = {"confidence": confidence, "sensitivity": not no_sensitivity}
+    try:
+        stats = study_statistics(res, 1.0 if target_margin is None else target_margin, **kw)
+    except ModelError as err:
+        if target_margin is not None or err.field != "--target-margin":
+            raise
+        stats = study_statistics(res, None, **kw)  # the search ends below the operating thrust
     if out is not None:
         import matplotlib
 

@@ -83,7 +83,7 @@ def _summary(res, study, out: Path, elapsed: float, written: list[str]) -> None:
                 where = ", ".join(f"{k} = {_fmt(v)}" for k, v in best["parameters"].items())
                 text = _fmt(best["value"])
                 if best["lower_bound"]:
-                    text = f">= {text} (stable up to thrust_max; {best['tied']} such designs)"
+                    text = f">= {text}: {best['warning']},"
                 t.add_row(f"largest {by}", f"{text} at {where}")
                 break
     t.add_row("store", str(out))

@@ -124,10 +124,12 @@ class StudyResult:
             if v in ds:
                 values[v] = self.kind_names(v).isel(sel).item()
         chosen, tied = float(value[idx]), int(np.count_nonzero(pick == pick[idx]))
-        left_out = 0
+        left_out, floor = 0, np.nan
         if not minimum:
             with np.errstate(invalid="ignore"):
-                left_out = int(np.count_nonzero(np.isfinite(bounds_all) & ~np.isfinite(value) & (bounds_all >= chosen)))
+                better = np.isfinite(bounds_all) & ~np.isfinite(value) & (bounds_all >= chosen)
+            left_out = int(np.count_nonzero(better))
+            floor = float(bounds_all[better].min()) if left_out else np.nan
         return {
             "parameters": params,
             "value": chosen,
@@ -136,8 +138,22 @@ class StudyResult:
             "lower_bound": bool(bound[idx]),
             "tied": tied,
             "censored_left_out": left_out,
-            "warning": _best_warning(by, chosen, bool(bound[idx]), tied, left_out),
+            "warning": _best_warning(by, chosen, bool(bound[idx]), tied, left_out, floor),
         }
+
+    def statistics(self, target_margin: float | None = 1.0, **kw):
+        """Uncertainty statistics of a random, Sobol or Saltelli study: distributions of the
+        critical thrust and margin with censoring at ``thrust_max``, the probability of a margin
+        below ``target_margin``, Sobol indices (:func:`impstab.studies.statistics.study_statistics`)."""
+        from .statistics import study_statistics
+
+        return study_statistics(self, target_margin, **kw)
+
+    def sensitivity(self, quantity: str | None = None, **kw):
+        """Sobol sensitivity indices (:func:`impstab.studies.sensitivity.sensitivity_indices`)."""
+        from .sensitivity import sensitivity_indices
+
+        return sensitivity_indices(self, quantity, **kw)
 
     def operating_thrust(self):
         """Operating thrust of every design (N), an array shaped like the designs; None if unset."""
@@ -239,17 +255,17 @@ class StudyResult:
         raise ModelError("--export", str(path), "must end in .nc (netCDF) or .csv")
 
 
-def _best_warning(by: str, value: float, bound: bool, tied: int, left_out: int) -> str | None:
+def _best_warning(by: str, value: float, bound: bool, tied: int, left_out: int, floor: float) -> str | None:
     """What :meth:`StudyResult.best` must say about a value set by the end of the search."""
     name = by.replace("_", " ")
     if bound:
-        text = f"stable up to thrust_max: the true {name} is larger than shown (at least {value:.6g})"
+        text = f"stable up to thrust_max: the true {name} is larger than shown"
         if tied > 1:
-            text += f"; a tie: {tied} designs are stable up to the same limit and cannot be ranked (this is the first)"
+            text += f"; a tie: {tied} designs are stable up to the same limit and cannot be ranked, this is the first"
         return text
     if left_out:
-        return (f"{left_out} designs left out by the selection are stable up to thrust_max ({name} at least "
-                f"{value:.6g}): this is the largest of the selection only, set by the end of the search; "
+        return (f"{left_out} designs left out by the selection are stable up to thrust_max, with {name}s of at least "
+                f"{floor:.6g}: {value:.6g} is the largest of the selection only, set by the end of the search; "
                 "raise analysis.thrust_max to rank them")
     return None
 

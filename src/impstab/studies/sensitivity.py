@@ -108,7 +108,7 @@ class SensitivityIndices:
     @property
     def estimator(self) -> str:
         return ("Saltelli design, SALib sobol.analyze" if self.method == "saltelli"
-                else "given data, RBD-FAST (SALib rbd_fast.analyze)")
+                else "given data, RBD-FAST by SALib rbd_fast.analyze")
 
     @property
     def note(self) -> str:
