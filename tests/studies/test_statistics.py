@@ -19,7 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
-from _study_helpers import write_study  # noqa: E402
+from _study_helpers import EXAMPLES, write_study  # noqa: E402
 from scipy import stats  # noqa: E402
 
 from impstab.cli import main  # noqa: E402
@@ -51,12 +51,19 @@ seed = {seed}
 BOUNDS = [(1.0e4, 3.0e4), (5.0e4, 1.5e5), (0.2, 0.4)]
 
 
-def fake_result(folder, method: str, n: int, thrust, *, seed: int = 3, status=None) -> StudyResult:
+def fake_result(folder, method: str, n: int, thrust, *, seed: int = 3, status=None,
+                operating: float = OPERATING) -> StudyResult:
     """A study's result (store layout, samples, attributes) with the critical thrusts ``thrust``
     (a function of the ``(designs, 3)`` parameter values): above ``thrust_max`` a design is
     stored as stable up to it, like the engine stores it."""
-    study = load_study(write_study(folder, THREE.format(method=method, n=n, seed=seed), chunk_size=None,
-                                   name=f"{method}.toml"))
+    model = "imp_symmetric.toml"
+    if operating != OPERATING:
+        folder.mkdir(parents=True, exist_ok=True)
+        model = "operating.toml"
+        text = (EXAMPLES / "imp_symmetric.toml").read_text()
+        (folder / model).write_text(text.replace("operating = 2000.0 ", f"operating = {operating!r} "))
+    study = load_study(write_study(folder, THREE.format(method=method, n=n, seed=seed), model=model,
+                                   chunk_size=None, name=f"{method}.toml"))
     ds = StudyStore.create_or_resume(study, plan_chunks(study), None).open_dataset().load()
     x = np.column_stack([ds[p].values for p in json.loads(ds.attrs["parameters"])])
     t = np.asarray(thrust(x), dtype=float)
@@ -65,7 +72,7 @@ def fake_result(folder, method: str, n: int, thrust, *, seed: int = 3, status=No
     stable = ok & (t > THRUST_MAX)
     crit = np.where(ok & ~stable, t, np.nan)
     kind = np.where(ok, np.where(stable, 0, 1), -1).astype(np.int8)
-    ds = ds.assign(critical_thrust=ds["critical_thrust"].copy(data=crit), margin=ds["margin"].copy(data=crit / OPERATING),
+    ds = ds.assign(critical_thrust=ds["critical_thrust"].copy(data=crit), margin=ds["margin"].copy(data=crit / operating),
                    kind=ds["kind"].copy(data=kind), status=ds["status"].copy(data=st))
     return StudyResult(ds, None), t
 
@@ -399,6 +406,17 @@ def test_stats_command_bad_input(random_case, tmp_path, capsys, args, field):
     assert main(argv) == 2
     assert field in capsys.readouterr().err
     assert not fig.exists() and not list(tmp_path.glob(".*part*"))
+
+
+def test_default_target_is_left_out_when_the_search_ends_below_the_operating_thrust(tmp_path, capsys):
+    res, _ = fake_result(tmp_path, "random", 200, lognormal_thrust, operating=25000.0)
+    assert res.operating_thrust()[0] == 25000.0
+    res.to_netcdf(tmp_path / "r.nc")
+    assert main(["stats", str(tmp_path / "r.nc"), "--json", "--no-sensitivity"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["probability"] is None and data["margin"]["exact_up_to"] == pytest.approx(0.8)
+    assert main(["stats", str(tmp_path / "r.nc"), "--target-margin", "1"]) == 2
+    assert "--target-margin" in capsys.readouterr().err
 
 
 def test_result_object_views(random_case):
