@@ -32,6 +32,30 @@ class StudyResult:
     dataset: Any
     store: str | None = None
 
+    def __repr__(self) -> str:
+        from ..display import study_text
+
+        return study_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import study_html
+
+        return study_html(self)
+
+    def __post_init__(self) -> None:
+        # parameter coordinates carry the units of their model-file keys
+        from ..model.reference import label, unit
+
+        ds = self.dataset
+        for p in json.loads(ds.attrs.get("parameters", "[]")):
+            if p in ds.coords and "units" not in ds[p].attrs:
+                u = unit(p)
+                if u is not None:
+                    ds[p].attrs["units"] = u
+                    ds[p].attrs.setdefault("label", label(p))
+        if "sample" in ds.coords and "units" not in ds["sample"].attrs:
+            ds["sample"].attrs["units"] = "1"
+
     @classmethod
     def from_store(cls, st) -> "StudyResult":
         return cls(st.load_dataset(), None if st.path is None else str(st.path))
