@@ -2,62 +2,45 @@
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
-
 import numpy as np
+
+from .handles import StatisticsAxes
+from .style import ONSET_COLOR, PALETTE, figure_style
 
 __all__ = ["StatisticsAxes", "plot_statistics", "plot_histogram", "plot_ecdf", "plot_sensitivity"]
 
 _LABELS = {"critical_thrust": "critical thrust (N)", "margin": "margin (critical / operating thrust)"}
-_BAR = "#0072B2"
-_TOTAL = "#E69F00"
+_BAR = PALETTE[0]
+_TOTAL = PALETTE[1]
 _CENSORED = "0.55"
-_TARGET = "#D55E00"
-
-
-class StatisticsAxes(NamedTuple):
-    """The panels of a statistics figure: ``histogram``, ``ecdf`` and ``sensitivity`` (None
-    when the study has no indices)."""
-
-    histogram: Any
-    ecdf: Any
-    sensitivity: Any
-
-    @property
-    def figure(self) -> Any:
-        """The matplotlib Figure."""
-        return self.ecdf.figure
+_TARGET = ONSET_COLOR
 
 
 def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
 
+def _parameter_label(path: str) -> str:
+    """The parameter's name from the model-file reference, over its path."""
+    from ..model.reference import label
+
+    name = label(path)
+    return f"{name}\n{path}" if name and name != path else path
+
+
 def _limit_name(dist) -> str:
     return "thrust_max" if dist.quantity == "critical_thrust" else "thrust_max / operating"
 
 
-def plot_statistics(stats, ax=None):
-    """Draw the distribution of the margin (or critical thrust) and the sensitivity indices.
-
-    Parameters
-    ----------
-    stats : UncertaintyStatistics
-    ax : matplotlib Axes or sequence of Axes, optional
-        None: a new figure of three panels (two without indices). One Axes: the ECDF only.
-        A sequence: the panels in order (histogram, ECDF, indices).
-
-    Returns
-    -------
-    StatisticsAxes or Axes
-        The panels (the Axes when one was given).
-    """
+def _plot_statistics(stats, ax=None):
+    """:func:`plot_statistics` inside the figure style."""
     import matplotlib.pyplot as plt
 
     dist = stats.main
     target = stats.probability
-    if ax is not None and not isinstance(ax, (list, tuple, np.ndarray)):
-        return plot_ecdf(dist, ax=ax, probability=target, operating=stats.operating_thrust)
+    if ax is not None and not isinstance(ax, (list, tuple, np.ndarray)):  # one Axes: the first panel
+        return _plot_histogram(dist, ax=ax, target=None if target is None else target.target,
+                               operating=stats.operating_thrust)
     if ax is None:
         n = 3 if stats.sensitivity is not None else 2
         fig, axes = plt.subplots(1, n, figsize=(4.6 * n, 4.4), layout="constrained",
@@ -67,12 +50,12 @@ def plot_statistics(stats, ax=None):
         fig.suptitle(f"{stats.study_name}: {stats.computed} computed designs ({how})", fontsize="medium")
     else:
         axes = list(ax)
-    h = plot_histogram(dist, ax=axes[0], target=None if target is None else target.target,
+    h = _plot_histogram(dist, ax=axes[0], target=None if target is None else target.target,
                        operating=stats.operating_thrust)
-    e = plot_ecdf(dist, ax=axes[1], probability=target, operating=stats.operating_thrust)
+    e = _plot_ecdf(dist, ax=axes[1], probability=target, operating=stats.operating_thrust)
     s = None
     if stats.sensitivity is not None and len(axes) > 2:
-        s = plot_sensitivity(stats.sensitivity, ax=axes[2])
+        s = _plot_sensitivity(stats.sensitivity, ax=axes[2])
     return StatisticsAxes(h, e, s)
 
 
@@ -88,9 +71,8 @@ def _thrust_axis(ax, dist, operating):
     sec.tick_params(labelsize="small")
 
 
-def plot_histogram(dist, ax=None, *, target: float | None = None, operating: float | None = None):
-    """Histogram of the observed values, the censored designs as a separate hatched bar beyond
-    the search limit; the target margin as a line. Returns the Axes."""
+def _plot_histogram(dist, ax=None, *, target: float | None = None, operating: float | None = None):
+    """:func:`plot_histogram` inside the figure style."""
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -128,11 +110,8 @@ def _percent_ticks(ax, n: int) -> None:
     ax.yaxis.set_major_formatter(FuncFormatter(lambda p, _: f"{100 * p:.3g} %"))
 
 
-def plot_ecdf(dist, ax=None, *, probability=None, operating: float | None = None):
-    """The empirical distribution function with its pointwise Clopper-Pearson band and the
-    simultaneous DKW band, on a logit axis (both tails readable), drawn only where it is known
-    (up to the smallest search limit of a censored design); the probability of a margin below
-    the target with its interval. Returns the Axes."""
+def _plot_ecdf(dist, ax=None, *, probability=None, operating: float | None = None):
+    """:func:`plot_ecdf` inside the figure style."""
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -181,8 +160,8 @@ def plot_ecdf(dist, ax=None, *, probability=None, operating: float | None = None
     return ax
 
 
-def plot_sensitivity(ind, ax=None):
-    """Horizontal bars of the first-order (and total) Sobol indices with their intervals."""
+def _plot_sensitivity(ind, ax=None):
+    """:func:`plot_sensitivity` inside the figure style."""
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -198,7 +177,7 @@ def plot_sensitivity(ind, ax=None):
         ax.barh(y - h / 2, ind.total_order, height=h, xerr=ind.total_order_conf, color=_TOTAL,
                 error_kw={"capsize": 3, "lw": 1},
                 label=f"total $S_T$, {100 * ind.confidence:g} % interval")
-    ax.set_yticks(y, list(ind.parameters))
+    ax.set_yticks(y, [_parameter_label(p) for p in ind.parameters])
     top = [ind.first_order + ind.first_order_conf]
     if both:
         top.append(ind.total_order + ind.total_order_conf)
@@ -215,3 +194,47 @@ def plot_sensitivity(ind, ax=None):
     ax.legend(loc="lower right", fontsize="small", framealpha=0.9)
     ax.tick_params(axis="y", labelsize="small")
     return ax
+
+
+def plot_statistics(stats, ax=None):
+    """Draw the distribution of the margin (or critical thrust) and the sensitivity indices.
+
+    Parameters
+    ----------
+    stats : UncertaintyStatistics
+    ax : matplotlib Axes or sequence of Axes, optional
+        None: a new figure of three panels (two without indices). One Axes: the first panel
+        (the histogram) only.
+        A sequence: the panels in order (histogram, ECDF, indices).
+
+    Returns
+    -------
+    StatisticsAxes or Axes
+        The panels (the Axes when one was given).
+    """
+    with figure_style():
+        return _plot_statistics(stats, ax)
+
+
+def plot_histogram(dist, ax=None, *, target: float | None = None, operating: float | None = None):
+    """Histogram of the observed values of a :class:`~impstab.studies.statistics.CensoredDistribution`,
+    the censored designs as a separate hatched bar beyond the search limit, the target margin as
+    a line; returns the Axes."""
+    with figure_style():
+        return _plot_histogram(dist, ax, target=target, operating=operating)
+
+
+def plot_ecdf(dist, ax=None, *, probability=None, operating: float | None = None):
+    """The empirical distribution function with its pointwise Clopper-Pearson band and the
+    simultaneous DKW band, on a logit axis (both tails readable), drawn only where it is known
+    (up to the smallest search limit of a censored design); the probability of a margin below
+    the target with its interval. Returns the Axes."""
+    with figure_style():
+        return _plot_ecdf(dist, ax, probability=probability, operating=operating)
+
+
+def plot_sensitivity(ind, ax=None):
+    """Horizontal bars of the first-order (and total) Sobol indices with their intervals;
+    returns the Axes."""
+    with figure_style():
+        return _plot_sensitivity(ind, ax)
