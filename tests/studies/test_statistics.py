@@ -395,7 +395,8 @@ def test_stats_command_table_json_and_figure(random_case, tmp_path, capsys):
 
 @pytest.mark.parametrize("args,field", [(["--target-margin", "11"], "--target-margin"),
                                         (["--target-margin", "-1"], "--target-margin"),
-                                        (["-o", "x.txt"], "--output"), (["--confidence", "1.5"], "--confidence")])
+                                        (["-o", "x.txt"], "--output"), (["--confidence", "1.5"], "--confidence"),
+                                        (["--dpi", "0"], "--dpi"), (["--dpi", "5000"], "--dpi")])
 def test_stats_command_bad_input(random_case, tmp_path, capsys, args, field):
     res, _, _ = random_case
     res.to_netcdf(tmp_path / "r.nc")
@@ -424,7 +425,8 @@ def test_result_object_views(random_case):
     s = study_statistics(res, 7.5)
     text = repr(s)
     assert len(text) < 1200 and "P(margin < 7.5)" in text and "censored" in text
-    assert "<table>" in s._repr_html_()
+    html = s._repr_html_()
+    assert html.count("<table") == 2 and "P(margin &lt; 7.5)" in html and "min(margin, 10)" in html
     ds = s.to_xarray()
     assert ds["critical_thrust_percentile"].attrs["units"] == "N"
     pct = ds["critical_thrust_percentile"].sel(percent=99.0)

@@ -2,81 +2,57 @@
 
 from __future__ import annotations
 
-import math
 import textwrap
 from pathlib import Path
 
 import click
 
 from ..errors import ModelError
-from ._common import check_number, console, print_json
+from ._common import check_number, console, draw_and_save, print_json, table
 
 __all__ = ["commands"]
 
-_FIGURES = (".png", ".svg", ".pdf")
+
+def _column(values: list[str], intervals: list[str]) -> list[str]:
+    """``value  [low, high]`` cells with the values right-aligned among themselves."""
+    width = max(len(v) for v in values)
+    return [f"{v.rjust(width)}  {i}" for v, i in zip(values, intervals)]
 
 
 def _percent_table(stats):
-    from rich import box
-    from rich.table import Table
-
-    t = Table(box=box.SIMPLE_HEAD, title=f"percentiles of the {stats.computed} computed designs, "
-              f"{100 * stats.confidence:g} % intervals", title_justify="left")
-    t.add_column("q", justify="right")
-    t.add_column("critical thrust (N)", justify="right")
-    t.add_column("interval (N)")
-    if stats.margin is not None:
-        t.add_column("margin", justify="right")
-        t.add_column("interval")
-    crit = stats.percentiles("critical_thrust") if stats.critical_thrust is not None else []
-    marg = stats.percentiles("margin") if stats.margin is not None else []
+    conf = f"{100 * stats.confidence:g} %"
+    cols = [("q", "right")]
+    cells = []
+    for name, head in (("critical_thrust", "critical thrust (N)"), ("margin", "margin")):
+        if getattr(stats, name) is None:
+            continue
+        ps = stats.percentiles(name)
+        cols.append(f"{head} [{conf} interval]")
+        cells.append(_column([p.text(units=False) for p in ps], [p.interval_text() for p in ps]))
+    t = table(f"percentiles of the {stats.computed} computed designs", *cols)
     for i, q in enumerate(stats.percents):
-        row = [f"{q:g} %"]
-        row += [crit[i].text(units=False), crit[i].interval_text()] if crit else ["n/a", ""]
-        if marg:
-            row += [marg[i].text(units=False), marg[i].interval_text()]
-        t.add_row(*row)
+        t.add_row(f"{q:g} %", *(c[i] for c in cells))
     return t
 
 
 def _sensitivity_table(ind):
-    from rich import box
-    from rich.table import Table
-
-    t = Table(box=box.SIMPLE_HEAD, title=f"Sobol indices of {ind.of}", title_justify="left")
     conf = f"{100 * ind.confidence:g} %"
-    t.add_column("parameter")
-    t.add_column(f"first order +- {conf}", justify="right")
-    if ind.total_order is not None:
-        t.add_column(f"total +- {conf}", justify="right")
-    for i, p in enumerate(ind.parameters):
-        row = [p, f"{ind.first_order[i]:.3f} +- {ind.first_order_conf[i]:.3f}"]
-        if ind.total_order is not None:
-            row.append(f"{ind.total_order[i]:.3f} +- {ind.total_order_conf[i]:.3f}")
-        t.add_row(*row)
+    cols = ["parameter", f"first order +- {conf}"] + ([f"total +- {conf}"] if ind.total_order is not None else [])
+    t = table(f"Sobol indices of {ind.of}", *cols)
+    rows = [ind.cells(i) for i in range(len(ind.parameters))]
+    widths = [max(len(r[j].split(" +- ")[0]) for r in rows) for j in range(len(cols) - 1)]
+    for p, r in zip(ind.parameters, rows):
+        t.add_row(p, *(c.rjust(len(c) + widths[j] - len(c.split(" +- ")[0])) for j, c in enumerate(r)))
     return t
 
 
 def _summary_table(stats):
-    from rich import box
-    from rich.table import Table
-
-    t = Table(box=box.SIMPLE_HEAD, show_header=False, title=f"statistics of {stats.study_name} ({stats.sampling})",
-              title_justify="left")
-    t.add_column("quantity", no_wrap=True)
-    t.add_column("value", max_width=58)
+    t = table(f"statistics of {stats.study_name} ({stats.sampling})", "quantity", "value")
     for k, v in stats.summary_rows():
         t.add_row(k, v)
     t.add_row("intervals", stats.intervals + (" (independent samples)" if stats.exact else
                                               " (those of independent sampling, for Sobol points)"))
     return t
-
-
-def _save(ax, out: Path, dpi: float | None) -> None:
-    from ..io import atomic_path
-
-    with atomic_path(out) as tmp:
-        ax.figure.savefig(tmp, format=out.suffix.lower().lstrip("."), dpi=dpi or 150)
 
 
 @click.command("stats")
@@ -89,21 +65,19 @@ def _save(ax, out: Path, dpi: float | None) -> None:
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object (units in docs/studies.md)")
 @click.option("-o", "--output", default=None, type=click.Path(dir_okay=False),
               help="figure (.png, .svg or .pdf): histogram, ECDF with its band, sensitivity indices")
-@click.option("--dpi", type=float, default=None, help="resolution of a PNG figure (default 150)")
+@click.option("--dpi", type=float, default=None, help="resolution of a PNG figure (default 150; SVG and PDF are vector)")
 def stats_cmd(store: str, target_margin: float | None, confidence: float, no_sensitivity: bool, as_json: bool,
               output: str | None, dpi: float | None) -> None:
     """Distribution of the critical thrust and margin, probability of missing a required margin
     and Sobol indices of the random, Sobol or Saltelli study in STORE."""
+    from ..plot.save import check_figure_path
     from ..studies import open_study
     from ..studies.statistics import study_statistics
 
     check_number("--target-margin", target_margin, positive=True)
     check_number("--confidence", confidence, positive=True)
-    out = Path(output) if output else None
-    if out is not None and out.suffix.lower() not in _FIGURES:
-        raise ModelError("--output", str(out), "must end in .png, .svg or .pdf")
-    if dpi is not None and not (math.isfinite(dpi) and 1 <= dpi <= 2400):
-        raise ModelError("--dpi", dpi, "must be between 1 and 2400")
+    check_number("--dpi", dpi, positive=True)
+    out = check_figure_path(output) if output else None
     res = open_study(store)
     kw = {"confidence": confidence, "sensitivity": not no_sensitivity}
     try:
@@ -113,25 +87,18 @@ def stats_cmd(store: str, target_margin: float | None, confidence: float, no_sen
             raise
         stats = study_statistics(res, None, **kw)  # the search ends below the operating thrust
     if out is not None:
-        import matplotlib
-
-        if matplotlib.get_backend().lower() != "agg":
-            matplotlib.use("Agg", force=True)
-        import matplotlib.pyplot as plt
-
-        axes = stats.plot()
-        try:
-            _save(axes, out, dpi)
-        finally:
-            plt.close(axes.figure)
+        draw_and_save(stats.plot, out, dpi)
     if as_json:
         print_json(stats.to_dict())
         return
     con = console()
     con.print(_summary_table(stats))
+    con.print()
     con.print(_percent_table(stats))
     if stats.sensitivity is not None:
+        con.print()
         con.print(_sensitivity_table(stats.sensitivity))
+    con.print()
     for note in stats.notes:
         click.echo(textwrap.fill(f"note: {note}", width=80, subsequent_indent="  "))
     if out is not None:

@@ -123,11 +123,13 @@ class SensitivityIndices:
 
     def summary(self) -> str:
         """One line: the indices per parameter."""
+        from ..display.format import number
+
         parts = []
         for i, p in enumerate(self.parameters):
-            s = f"{p} S1 {self.first_order[i]:.2f}"
+            s = f"{p} S1 {number(self.first_order[i], 2, fmt='f')}"
             if self.total_order is not None:
-                s += f" ST {self.total_order[i]:.2f}"
+                s += f" ST {number(self.total_order[i], 2, fmt='f')}"
             parts.append(s)
         return f"Sobol indices of {self.of}: " + ", ".join(parts)
 
@@ -168,17 +170,25 @@ class SensitivityIndices:
     def __repr__(self) -> str:
         return f"SensitivityIndices({self.method}, {self.summary()})"
 
-    def _repr_html_(self) -> str:
-        from html import escape
+    def cells(self, i: int) -> list[str]:
+        """``["0.980 +- 0.006", ...]``: the indices of parameter ``i`` with their half-widths."""
+        from ..display.format import number
 
-        head = "<tr><th>parameter</th><th>first order</th>" + ("<th>total</th>" if self.total_order is not None else "") + "</tr>"
-        body = ""
-        for i, p in enumerate(self.parameters):
-            body += f"<tr><td>{escape(p)}</td><td>{self.first_order[i]:.3f} &plusmn; {self.first_order_conf[i]:.3f}</td>"
-            if self.total_order is not None:
-                body += f"<td>{self.total_order[i]:.3f} &plusmn; {self.total_order_conf[i]:.3f}</td>"
-            body += "</tr>"
-        return f"<div>{escape(self.note)}<table>{head}{body}</table></div>"
+        def cell(v, c):
+            return f"{number(v, 3, fmt='f')} +- {number(c, 3, fmt='f')}"
+
+        out = [cell(self.first_order[i], self.first_order_conf[i])]
+        if self.total_order is not None:
+            out.append(cell(self.total_order[i], self.total_order_conf[i]))
+        return out
+
+    def _repr_html_(self) -> str:
+        from ..display.html import html_table
+
+        conf = f"+- {100 * self.confidence:g} %"
+        header = ["parameter", f"first order {conf}"] + ([f"total {conf}"] if self.total_order is not None else [])
+        rows = [[p, *self.cells(i)] for i, p in enumerate(self.parameters)]
+        return html_table(self.note, rows, header=header)
 
 
 def _inputs(result) -> NDArray[np.float64]:

@@ -77,10 +77,10 @@ _NAMES = {"critical_thrust": "critical thrust", "margin": "margin"}
 
 
 def _number(v: float, units: str = "") -> str:
-    """5 significant digits for a force (N), 4 for a margin or a ratio."""
-    if units == "N":
-        return f"{v:.5g} N"
-    return f"{v:.4g}" + (f" {units}" if units and units != "1" else "")
+    """5 significant digits for a force (N), 4 for a margin or a ratio (never ``-0``)."""
+    from ..display.format import number
+
+    return number(v, 5 if units == "N" else 4, "" if units == "1" else units)
 
 
 @dataclass(frozen=True)
@@ -120,7 +120,7 @@ class Percentile:
     def text(self, units: bool = True) -> str:
         """``"12345 N"`` or ``"> 30000 N"`` (without the unit if ``units`` is False)."""
         def num(v):
-            return _number(v, self.units) if units or self.units != "N" else f"{v:.5g}"
+            return _number(v, self.units) if units or self.units != "N" else _number(v, "N").removesuffix(" N")
 
         return num(self.value) if self.value is not None else f"> {num(self.above)}"
 
@@ -130,8 +130,10 @@ class Percentile:
         def end(v, above):
             u = "" if self.units == "N" else self.units
             if v is not None:
-                return _number(v, u) if u else f"{v:.5g}"
-            return (f"> {_number(above, u)}" if u else f"> {above:.5g}") if above is not None else "?"
+                return _number(v, u) if u else _number(v, "N").removesuffix(" N")
+            if above is None:
+                return "?"
+            return f"> {_number(above, u)}" if u else f"> {_number(above, 'N').removesuffix(' N')}"
 
         return f"[{end(self.low, self.low_above)}, {end(self.high, self.high_above)}]"
 
@@ -536,15 +538,13 @@ class UncertaintyStatistics:
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        from html import escape
+        from ..display.html import html_table
 
-        rows = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th><td style='text-align:left'>{escape(v)}</td></tr>"
-                       for k, v in self.summary_rows())
-        head = f"<b>{escape(self.study_name)}</b>: statistics of {self.computed} designs ({escape(self.sampling)})"
-        html = f"<div>{head}<table>{rows}</table>"
+        html = html_table(f"statistics of {self.study_name} ({self.sampling}, {self.computed} designs)",
+                          self.summary_rows())
         if self.sensitivity is not None:
             html += self.sensitivity._repr_html_()
-        return html + "</div>"
+        return f"<div>{html}</div>"
 
 
 def _status_counts(status: NDArray) -> tuple[dict[str, int], int]:
