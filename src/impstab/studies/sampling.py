@@ -51,7 +51,7 @@ def check_distribution(spec: ParameterSpec) -> None:
         raise ValueError("give either values (a range or a list) or a distribution, not both or neither")
     if isinstance(spec.values, RangeSpec):
         if spec.values.num is not None:
-            raise ValueError("num: is only used with grid sampling (random and sobol draw sampling.n values)")
+            raise ValueError("num: is only used with grid sampling (random, sobol and saltelli draw their own values)")
         if spec.values.stop <= spec.values.start:
             raise ValueError("stop must be greater than start")
         if spec.values.scale == "log" and spec.values.start <= 0:
