@@ -76,11 +76,17 @@ _UNITS = {"critical_thrust": "N", "margin": "1"}
 _NAMES = {"critical_thrust": "critical thrust", "margin": "margin"}
 
 
-def _number(v: float, units: str = "") -> str:
-    """5 significant digits for a force (N), 4 for a margin or a ratio (never ``-0``)."""
+def _plain(v: float, units: str = "") -> str:
+    """5 significant digits for a force (N), 4 for a margin or a ratio (never ``-0``), no unit."""
     from ..display.format import number
 
-    return number(v, 5 if units == "N" else 4, "" if units == "1" else units)
+    return number(v, 5 if units == "N" else 4)
+
+
+def _number(v: float, units: str = "") -> str:
+    """:func:`_plain` with its unit (none for a ratio)."""
+    text = _plain(v, units)
+    return f"{text} {units}" if units not in ("", "1") else text
 
 
 @dataclass(frozen=True)
@@ -119,21 +125,16 @@ class Percentile:
 
     def text(self, units: bool = True) -> str:
         """``"12345 N"`` or ``"> 30000 N"`` (without the unit if ``units`` is False)."""
-        def num(v):
-            return _number(v, self.units) if units or self.units != "N" else _number(v, "N").removesuffix(" N")
-
-        return num(self.value) if self.value is not None else f"> {num(self.above)}"
+        num = _number if units else _plain
+        return num(self.value, self.units) if self.value is not None else f"> {num(self.above, self.units)}"
 
     def interval_text(self) -> str:
         """``"[lo, hi]"`` (without the unit); an end above the search limit shows as ``> limit``,
         one beyond the sample as ``?``."""
         def end(v, above):
-            u = "" if self.units == "N" else self.units
             if v is not None:
-                return _number(v, u) if u else _number(v, "N").removesuffix(" N")
-            if above is None:
-                return "?"
-            return f"> {_number(above, u)}" if u else f"> {_number(above, 'N').removesuffix(' N')}"
+                return _plain(v, self.units)
+            return "?" if above is None else f"> {_plain(above, self.units)}"
 
         return f"[{end(self.low, self.low_above)}, {end(self.high, self.high_above)}]"
 
