@@ -233,9 +233,15 @@ def _model(tmp_path, examples, **replace):
 def test_operating_thrust_above_the_search_range(capsys, examples, tmp_path):
     # the case: thrust_max 15000 N below the operating thrust 20000 N
     path = _model(tmp_path, examples, **{"operating = 2000.0": "operating = 20000.0", "thrust_max = 20000.0": "thrust_max = 15000.0"})
-    one_line_error(capsys, "critical", path, field="analysis.thrust_max")
-    path = _model(tmp_path, examples)
-    one_line_error(capsys, "critical", path, "--thrust-max", "1500", field="--thrust-max")
+    for args in ((path,), (str(examples / "imp_symmetric.toml"), "--thrust-max", "1500")):
+        code, out, err = run(capsys, "critical", *args, "--json")
+        d = json.loads(out)
+        assert code == 0 and d["critical_thrust"] is None and d["margin"] is None
+        assert any("below the operating thrust" in w and "not established" in w for w in d["warnings"])
+        code, out, err = run(capsys, "critical", *args)
+        assert code == 0 and "not established" in out and "stability at the operating point" in " ".join(out.split())
+    code, out, err = run(capsys, "check", path)
+    assert code == 0 and "not established" in out
 
 
 def test_unstable_at_the_operating_thrust_is_said(capsys, examples, tmp_path):

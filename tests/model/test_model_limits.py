@@ -100,11 +100,18 @@ def test_hull_too_slender_for_the_quadrature_is_refused_with_the_hull_key():
     refused(d, "hull.length", "quadrature nodes", "strip theory")
 
 
-def test_thrust_max_must_cover_the_operating_thrust():
+def test_a_search_below_the_operating_thrust_says_so():
+    """The issue's case: thrust_max 15000 N below the operating thrust 20000 N of a model that is
+    unstable from 18012 N (the closed form of the symmetric ring, tests/linear)."""
     d = ring_model_dict(thrust={"operating": 20000.0}, analysis={"thrust_max": 15000.0})
-    refused(d, "analysis.thrust_max", "20000 N", "operating point")
-    d["analysis"] = {}
+    res = impstab.critical_thrust(model_from_dict(d))
+    assert res.thrust is None and res.margin is None
+    assert any("below the operating thrust 20000 N" in w and "not established" in w for w in res.warnings)
+    d["analysis"] = {}                               # the default search covers the operating point
+    res = impstab.critical_thrust(model_from_dict(d))
     assert model_from_dict(d).analysis.thrust_max == 200000.0
+    assert res.thrust == pytest.approx(18012.0999227555, rel=1e-9) and res.margin < 1
+    assert any("unstable at its operating thrust 20000 N" in w for w in res.warnings)
 
 
 def test_a_zero_length_direction_is_refused():

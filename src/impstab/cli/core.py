@@ -33,10 +33,15 @@ def _margin_rows(res, damped: bool | None = None) -> list[tuple[str, str]]:
     from ..display.text import critical_rows
 
     rows = critical_rows(res, damped)
+    op = res.operating_thrust
     if res.margin is not None and res.margin < 1.0:
-        rows = [(k, f"{v} [red](UNSTABLE at the operating thrust)[/red]" if k.startswith("margin") else v)
-                for k, v in rows]
-    return rows
+        note = f"{{}} [red](UNSTABLE at the operating thrust)[/red]"
+    elif res.margin is None and op and res.thrust_max < op:
+        note = (f"> {res.thrust_max / op:.4g}, [yellow]not established[/yellow]: the search ends at "
+                f"{res.thrust_max:g} N, below the operating thrust {op:g} N")
+    else:
+        return rows
+    return [(k, note.format(v) if k.startswith("margin") else v) for k, v in rows]
 
 
 def _vec(v, unit: str) -> str:
@@ -254,10 +259,6 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
 
     thrust_max = check_number("--thrust-max", thrust_max, kind="thrust")
     model = _load(model_file)
-    op = model.thrust.operating
-    if thrust_max is not None and op is not None and thrust_max < op:
-        raise ModelError("--thrust-max", thrust_max, f"must be at least the operating thrust {op:g} N, so that "
-                                                     "the search covers the operating point")
     res = critical_thrust(model, thrust_max=thrust_max, linearization=linearization, all_crossings=all_crossings)
     if as_json:
         print_json(res.to_dict())

@@ -277,12 +277,8 @@ def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
         if t.operating is None:
             raise ModelError("analysis.thrust_max", None, "is required when thrust.operating is not given")
         thrust_max = min(10.0 * t.operating, RANGES["thrust"].high)
-    elif t.operating is not None and thrust_max < t.operating:
-        raise ModelError(
-            "analysis.thrust_max", thrust_max,
-            f"must be at least thrust.operating = {t.operating:g} N, so that the critical-thrust search "
-            "covers the operating point (leave it out for 10 x operating)",
-        )
+    # a thrust_max below the operating thrust is allowed (a search of the low range); every result
+    # of the critical-thrust search then says that it did not reach the operating point
     fluid, hull = _fluid(doc)
     return Model(
         body=body, mounts=mounts, thrust=thrust,

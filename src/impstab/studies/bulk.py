@@ -9,8 +9,8 @@ forms ``K = K0 + T K1`` of all designs come from one compiled loop
 (:func:`~impstab.linear.linearize.affine_forms`, the function every :class:`ModelFamily` uses).
 
 Every design is still validated like a model file: each value by its field's schema rule, and
-the model rules the changed values can break (the mounts must restrain all six rigid-body
-motions, on the assembled stiffness with a margin; ``thrust_max`` covers the operating thrust). A design that fails or comes near either,
+the model rule the changed values can break (the mounts must restrain all six rigid-body
+motions) on the assembled stiffness, with a margin. A design that fails or comes near either,
 or whose equilibrium would rotate under thrust (not affine), is handed back to the per-variant
 path, which gives it its exact status and message (:func:`impstab.model.model_from_dict`).
 
@@ -145,9 +145,6 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
     operating = values.get(("thrust", "operating"), np.full(n, np.nan if pk.operating is None else pk.operating))
     t_max = doc.analysis.thrust_max
     thrust_max = np.full(n, float(t_max)) if t_max is not None else np.minimum(10.0 * operating, RANGES["thrust"].high)
-    # the model rule "thrust_max covers the operating thrust": a design that breaks it takes the
-    # per-variant path, which refuses it with the model file's message
-    bad |= operating > thrust_max
     arms = np.concatenate([np.linalg.norm(positions, axis=-1), np.full((n, 1), np.linalg.norm(pk.r_thrust))], axis=1)
     length_scale = np.maximum(arms.max(axis=1), 1e-3)
     # the model rule "the mounts restrain all six motions", on the condensed stiffness
