@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from ..errors import ModelError
-from ._common import check_number, console
+from ._common import check_number
 
 __all__ = ["commands"]
 
@@ -68,6 +68,7 @@ def report_cmd(ctx: click.Context, model_or_store: str, output: str | None, sect
     import matplotlib
 
     from ..report import report
+    from ..report.render import printable
     from ..report.result import check_report_path
 
     if matplotlib.get_backend().lower() != "agg":
@@ -86,15 +87,14 @@ def report_cmd(ctx: click.Context, model_or_store: str, output: str | None, sect
         if exc.field in _OPTION:
             raise ModelError(_OPTION[exc.field], exc.value, exc.rule) from None
         raise
-    con = console()
     states: dict[str, list[str]] = {}
     for s in rep.sections:
         states.setdefault(s.status, []).append(s.name)
-    con.print(f"wrote {out}: {len(rep.sections)} sections ("
-              + ", ".join(f"{len(v)} {k}" for k, v in states.items()) + f"), {rep.figures} figures, {rep.tables} tables")
+    click.echo(f"wrote {printable(str(out))}: {len(rep.sections)} sections ("
+               + ", ".join(f"{len(v)} {k}" for k, v in states.items()) + f"), {rep.figures} figures, {rep.tables} tables")
     for s in rep.sections:
         if s.status == "not computed":
-            con.print(f"{s.name}: not computed: {s.reason}", markup=False)
+            click.echo(f"{s.name}: not computed: {s.reason}")
         elif s.status == "failed":
             click.echo(f"impstab: warning: section {s.name} failed: {s.reason}", err=True)
 

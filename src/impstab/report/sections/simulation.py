@@ -79,7 +79,8 @@ def simulation_section(ctx: ModelContext) -> Section:
 
     title = "Time histories below, at and above the critical thrust"
     if not ctx.options.simulation:
-        return Section("simulation", title, NOT_COMPUTED, "left out of this report (no simulation asked for)")
+        return Section("simulation", title, NOT_COMPUTED, "left out of this report: no time histories asked for "
+                                                          "(--no-simulation; simulation=False in Python)")
     settings = run_settings(ctx)
     if isinstance(settings, str):
         return Section("simulation", title, NOT_COMPUTED, settings)
