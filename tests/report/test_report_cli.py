@@ -29,8 +29,8 @@ def test_no_simulation_and_the_default_name(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["report", str(model), "--no-simulation", "--sections", "simulation"]) == 0
     out = capsys.readouterr().out
-    assert "\nsimulation: not computed: left out of this report: no time histories asked for (--no-simulation; "
-            "simulation=False in Python)\n" in out
+    assert ("\nsimulation: not computed: left out of this report: no time histories asked for (--no-simulation; "
+            "simulation=False in Python)\n") in out
     html = (tmp_path / "imp_symmetric-report.html").read_text(encoding="utf-8")
     assert parse(html).sections["simulation"] == "not computed"
     assert "--no-simulation" in page_text(html)

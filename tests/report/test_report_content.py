@@ -434,3 +434,25 @@ def test_bad_input_names_the_field(tmp_path):
     (tmp_path / "study.toml").write_text(GRID_STUDY.format(name="s"))
     with pytest.raises(ModelError, match="is a study file"):
         impstab.report(tmp_path / "study.toml")
+
+
+def test_time_histories_of_a_compressible_fluid_model_say_what_they_cannot_show(tmp_path):
+    """The time simulation takes the fluid at 0 Hz (no radiation damping): above the critical
+    thrust set by radiation damping its linearization (numpy) is still neutral, and the report says so."""
+    path = copy_example(tmp_path, "imp_fluid.toml")
+    rep = impstab.report(path, sections=["simulation"])
+    runs = rep.section("simulation").data["runs"]
+    model = impstab.load_model(path)
+    lam = np.linalg.eigvals(impstab.linearize(model, runs[-1].thrust[0]).state_matrix())
+    assert abs(lam.real.max()) <= 1e-10 * np.abs(lam).max()
+    text = page_text(rep.html)
+    assert "the run above the critical thrust does not grow" in text
+    assert "without the radiation damping" in text
+
+
+def test_the_package_is_the_function():
+    import impstab.report as module
+    from impstab import report
+
+    assert report is module is impstab.report
+    assert callable(module) and module.report.__module__ == "impstab.report.api"

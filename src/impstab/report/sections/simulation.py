@@ -32,6 +32,8 @@ THRUST_FACTORS = (0.9, 1.0, 1.05)
 GROWTH_FOLDS = 3.0
 #: shortest and longest default length, in periods of the onset frequency
 MIN_PERIODS, MAX_PERIODS = 40, 400
+#: growth over a run (e-foldings of the supercritical linear rate) below which it is invisible and said so
+WEAK_GROWTH = 0.1
 #: default length (s) when the onset is a divergence (no frequency)
 DIVERGENCE_DURATION = 5.0
 _KINDS = ("subcritical", "at the critical thrust", "supercritical")
@@ -116,5 +118,20 @@ def simulation_section(ctx: ModelContext) -> Section:
         table("runs", rows, ["thrust (N)", "class", "envelope", "fitted growth (1/s)", "max Re λ (1/s)", "outcome"],
               ["left", "left", "left", "right", "right", "left"]),
     ]
+    last = runs[-1]
+    super_rate = last.growth.linear_rate if last.growth is not None else None
+    if super_rate is not None and abs(super_rate) <= 1e-10 * last.fastest_omega:
+        text = (f"At {number(last.thrust[0])} N the simulated system has max Re λ = 0 to rounding: the run above the "
+                "critical thrust does not grow.")
+        if ctx.model.fluid.compressible:
+            own = (f"the undamped critical thrust {number(ctx.critical.undamped_thrust)} N" if not ctx.model.is_damped
+                   else "that of the model with its mount dampers but without radiation damping")
+            text += (" The time simulation takes the fluid coefficients at 0 Hz, without the radiation damping that "
+                     f"sets this model's critical thrust through the onset frequency; its own onset is {own}.")
+        blocks.append(Note(text))
+    elif super_rate is not None and 0 < super_rate * duration < WEAK_GROWTH:
+        blocks.append(Note(f"The supercritical growth rate {number(super_rate, 3)} 1/s doubles the amplitude only "
+                           f"every {number(math.log(2) / super_rate, 3)} s: the instability is too weak to be seen in "
+                           f"a run of {number(duration, 4)} s (it is real, but slow)."))
     blocks += [Note(w, "warning") for w in sorted({str(w.message) for w in caught})]
     return Section("simulation", title, blocks=tuple(blocks), data={"runs": tuple(runs)})
