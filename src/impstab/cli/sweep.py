@@ -80,7 +80,7 @@ def _summary(res, study, out: Path, elapsed: float, written: list[str]) -> None:
                                   for k, v in best["parameters"].items())
                 text = _fmt(best["value"], u)
                 if best["lower_bound"]:
-                    text = f">= {text}: stable up to thrust_max, as are {best['tied']} designs; the first"
+                    text = f">= {text}: {best['warning']},"
                 t.add_row(f"largest {by}", f"{text} at {where}")
                 break
     t.add_row("store", str(out))

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any, NamedTuple
 
-__all__ = ["LocusAxes", "SimulationAxes"]
+__all__ = ["LocusAxes", "SimulationAxes", "StatisticsAxes"]
 
 
 class LocusAxes(NamedTuple):
@@ -38,3 +38,17 @@ class SimulationAxes(NamedTuple):
         while isinstance(first, (list, tuple)) or hasattr(first, "shape"):
             first = first[0]
         return first.figure
+
+
+class StatisticsAxes(NamedTuple):
+    """The panels of the statistics of a sampled study: ``histogram``, ``ecdf`` and
+    ``sensitivity`` (None when the study has no indices)."""
+
+    histogram: Any
+    ecdf: Any
+    sensitivity: Any
+
+    @property
+    def figure(self) -> Any:
+        """The matplotlib Figure."""
+        return self.ecdf.figure

@@ -23,13 +23,13 @@ STUDY_REFERENCE: dict[str, E] = {
                "parameters changed."),
     "outputs": E("", f"What is stored for every design: {_outputs}."),
     "parameters": E("", "One table per varied model-file value (at most 32). A grid has one dimension per "
-                    "parameter; random and sobol sampling draw every parameter for each sample."),
+                    "parameter; random, sobol and saltelli sampling draw every parameter for each sample."),
     "parameters[].path": E("", "Dotted path of the value in the model file: keys joined by '.', list entries by "
                            "[index], e.g. mount_rings[0].k_shear, mounts[2].position[1], thrust.operating. It must "
                            "end at one number, integer, flag or word (see docs/model-file.md for the keys and "
                            "their units); schema_version and name cannot be varied."),
     "parameters[].values": E("the path's unit", "The values: a range table {start, stop, num, scale} (a grid of num "
-                             "values; with random or sobol sampling and no num, a uniform or log-uniform range) "
+                             "values; with random, sobol or saltelli sampling and no num, a uniform or log-uniform range) "
                              "or a list of values (a grid axis, or values drawn with equal probabilities). Each "
                              "value is checked by the rule of its model-file key."),
     "parameters[].values.start": E("the path's unit", "First value of the range."),
@@ -37,8 +37,8 @@ STUDY_REFERENCE: dict[str, E] = {
     "parameters[].values.num": E("", "Number of grid values from start to stop; grid sampling only."),
     "parameters[].values.scale": E("", "\"linear\": equal steps; \"log\": geometric steps (start and stop > 0), "
                                    "log-uniform when sampled."),
-    "parameters[].distribution": E("", "A probability distribution of the value, instead of values (random and sobol "
-                                   "sampling only)."),
+    "parameters[].distribution": E("", "A probability distribution of the value, instead of values (random, sobol "
+                                   "and saltelli sampling only)."),
     "parameters[].distribution.kind": E("", "\"uniform\" and \"loguniform\" (low, high); \"normal\" (mean, std); "
                                         "\"lognormal\" (median, sigma of the logarithm); \"truncnormal\" (mean, std, "
                                         "low, high)."),
@@ -51,9 +51,13 @@ STUDY_REFERENCE: dict[str, E] = {
                                          "about 20 % scatter."),
     "sampling": E("", "How the designs are chosen."),
     "sampling.method": E("", "\"grid\": every combination of the parameters' values; \"random\": independent "
-                         "draws; \"sobol\": a scrambled Sobol sequence (use a power of two for n)."),
-    "sampling.n": E("", "Number of samples (random and sobol only)."),
-    "sampling.seed": E("", "Seed of the random and Sobol samples: the samples follow from the study file alone."),
+                         "draws; \"sobol\": a scrambled Sobol sequence (use a power of two for n); \"saltelli\": "
+                         "Saltelli's cross-sampled design for first-order and total Sobol indices (impstab stats), "
+                         "n base samples giving n * (d + 2) designs for d parameters."),
+    "sampling.n": E("", "Number of samples (random and sobol), or of base samples (saltelli: n * (d + 2) designs); "
+                    "not used by a grid."),
+    "sampling.seed": E("", "Seed of the random, Sobol and Saltelli samples: the samples follow from the study file "
+                       "alone."),
     "execution": E("", "How the work is cut up."),
     "execution.chunk_size": E("", "Designs computed, written and resumed together (the unit of work of a Dask "
                               "worker and of resuming)."),

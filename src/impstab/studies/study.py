@@ -231,7 +231,9 @@ def study_from_dict(
     else:
         if doc.sampling.n is None:
             raise ModelError("sampling.n", None, f"is required with sampling.method = {method!r} (the number of samples)")
-        size = doc.sampling.n
+        from .sampling import design_count  # n base samples of a Saltelli design are n * (d + 2) designs
+
+        size = design_count(method, doc.sampling.n, len(paths))
     if size > MAX_DESIGNS:
         raise ModelError("parameters", f"{size} designs", f"more than {MAX_DESIGNS} designs in one study")
     if method != "grid":
