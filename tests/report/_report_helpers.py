@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import html
 import re
 import shutil
 from html.parser import HTMLParser
@@ -108,13 +109,13 @@ def page_text(html: str) -> str:
     return re.sub(r"\s+", " ", " ".join(parse(html).text))
 
 
-def table_rows(html: str, caption_start: str) -> list[list[str]]:
-    """Cell texts of the table whose caption starts with ``caption_start``."""
-    m = re.search(r"<table[^>]*><caption[^>]*>" + re.escape(caption_start) + r".*?</table>", html, re.S)
+def table_rows(page: str, caption_start: str) -> list[list[str]]:
+    """Cell texts (entities decoded) of the table whose caption starts with ``caption_start``."""
+    m = re.search(r"<table[^>]*><caption[^>]*>" + re.escape(caption_start) + r".*?</table>", page, re.S)
     assert m, f"no table {caption_start!r}"
     rows = []
     for tr in re.findall(r"<tr>(.*?)</tr>", m.group(0), re.S):
         cells = re.findall(r"<td[^>]*>(.*?)</td>", tr, re.S)
         if cells:
-            rows.append([re.sub(r"<[^>]+>", "", c) for c in cells])
+            rows.append([html.unescape(re.sub(r"<[^>]+>", "", c)) for c in cells])
     return rows

@@ -51,6 +51,7 @@ def test_study_store_report(tmp_path, monkeypatch, capsys):
     (["--duration", "0"], "--duration"),
     (["--duration", "nan"], "--duration"),
     (["--steps", "0"], "--steps"),
+    (["--target-margin", "-1"], "--target-margin"),
 ])
 def test_bad_options_exit_2_with_one_line(tmp_path, capsys, args, field, monkeypatch):
     model = copy_example(tmp_path, "imp_symmetric.toml")

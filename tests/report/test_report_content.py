@@ -296,11 +296,11 @@ def test_best_designs_say_when_they_are_censored(study):
     best = {r[0]: r for r in rows}
     top = best["largest, all designs"]
     limit = 20000.0 / 2000.0
-    assert top[1] == f"&gt;= {limit:g}" and "censored" in top[3]
+    assert top[1] == f">= {limit:g}" and "stable up to thrust_max: the true margin is larger than shown" in top[3]
     found = best["largest with an onset found within the search"]
     margins = ds["margin"].values[ds["kind"].values != 0]
     assert _number(found[1]) == pytest.approx(np.nanmax(margins), rel=1e-3)
-    assert f"{censored} censored designs left out are better" in found[3]
+    assert f"{censored} designs left out by the selection are stable up to thrust_max" in found[3]
     worst = best["smallest (the worst design)"]
     assert _number(worst[1]) == pytest.approx(np.nanmin(ds["margin"].values), rel=1e-3)
 
@@ -372,7 +372,7 @@ class FakeStatistics:
         return ax
 
 
-def fake_statistics(result):
+def fake_statistics(result, target_margin):
     assert result.dataset.attrs["sampling"] == "random"
     return FakeStatistics()
 
@@ -456,3 +456,20 @@ def test_the_package_is_the_function():
 
     assert report is module is impstab.report
     assert callable(module) and module.report.__module__ == "impstab.report.api"
+
+
+def test_statistics_of_a_sampled_study(tmp_path):
+    """The statistics section of a random study, with the probability of missing the required
+    margin counted again from the stored margins (censored designs are above every target)."""
+    result = run_study_file(tmp_path, RANDOM_STUDY)
+    rep = impstab.report(result, sections=["statistics", "best"], target_margin=8.0)
+    sec = rep.section("statistics")
+    assert sec.status == "computed" and len(sec.figures) == 1
+    margin = result.dataset["margin"].values
+    ok = result.dataset["status"].values == 0
+    below = int(np.count_nonzero(ok & (margin < 8.0)))
+    rows = dict(table_rows(rep.html, "uncertainty statistics"))
+    assert f"({below} of {int(ok.sum())})" in rows["P(margin < 8)"]
+    assert "percentiles with their 95 % intervals" in rep.html
+    assert "sensitivity indices not computed: STORE = '12 computed designs': too few" in page_text(rep.html)
+    assert rep.section("best").status == "computed"

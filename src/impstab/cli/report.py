@@ -13,7 +13,7 @@ from ._common import check_number
 __all__ = ["commands"]
 
 #: API argument -> the option that sets it (errors name the option)
-_OPTION = {"sections": "--sections", "duration": "--duration", "steps": "--steps", "MODEL_OR_STORE": "MODEL_OR_STORE"}
+_OPTION = {"sections": "--sections", "duration": "--duration", "steps": "--steps", "target_margin": "--target-margin"}
 
 
 def _default_output(source: str) -> Path:
@@ -54,9 +54,12 @@ def _command_line(ctx: click.Context) -> str:
 @click.option("--duration", type=float, default=None,
               help="length of each time history (s); default: the supercritical run grows by e^3, 40 to 400 periods")
 @click.option("--steps", type=int, default=200, show_default=True, help="thrust intervals of the locus")
+@click.option("--target-margin", type=float, default=None,
+              help="study statistics: required margin, the probability of a margin below it (default 1)")
 @click.pass_context
 def report_cmd(ctx: click.Context, model_or_store: str, output: str | None, sections: str | None,
-               no_simulation: bool, title: str | None, duration: float | None, steps: int) -> None:
+               no_simulation: bool, title: str | None, duration: float | None, steps: int,
+               target_margin: float | None) -> None:
     """An HTML report of MODEL_OR_STORE: a model file (.toml) or a study store (impstab sweep).
 
     One self-contained file (inline SVG figures and CSS, no script, nothing fetched) with the
@@ -75,6 +78,7 @@ def report_cmd(ctx: click.Context, model_or_store: str, output: str | None, sect
         matplotlib.use("Agg", force=True)
     out = check_report_path(output) if output is not None else _default_output(model_or_store)
     check_number("--duration", duration, positive=True)
+    check_number("--target-margin", target_margin, positive=True)
     chosen = None
     if sections is not None:
         chosen = [s.strip() for s in sections.split(",") if s.strip()]
@@ -82,7 +86,7 @@ def report_cmd(ctx: click.Context, model_or_store: str, output: str | None, sect
             raise ModelError("--sections", sections, "must name at least one section, separated by commas")
     try:
         rep = report(model_or_store, out, sections=chosen, simulation=not no_simulation, title=title,
-                     duration=duration, steps=steps, command=_command_line(ctx))
+                     duration=duration, steps=steps, target_margin=target_margin, command=_command_line(ctx))
     except ModelError as exc:
         if exc.field in _OPTION:
             raise ModelError(_OPTION[exc.field], exc.value, exc.rule) from None

@@ -10,9 +10,10 @@ returns a result object, and the section is drawn from that object alone:
   ``to_dict()`` has the keys of ``impstab postcritical --json`` (DESIGN.md: ``critical_thrust``,
   ``kind``, ``omega``, ``lyapunov_coefficient``, ``bifurcation``, ``fold_thrust``, ``branch``)
   and whose ``plot(ax=None)`` draws the bifurcation diagram;
-* **statistics** (``PROVIDERS["statistics"]``, called as ``f(study_result)``): an object with
-  ``_repr_html_()`` (its tables) and ``plot(ax=None)`` (its figure), optionally
-  ``summary_rows()`` (``(quantity, value)`` text pairs).
+* **statistics** (``PROVIDERS["statistics"]``, called as ``f(study_result, target_margin)``,
+  :func:`impstab.studies.statistics.study_statistics`): an object with ``summary_rows()``
+  (``(quantity, value)`` text pairs) or ``_repr_html_()``, and ``plot(ax=None)``; its
+  ``percentiles(quantity)``, ``sensitivity`` and ``notes`` are shown when it has them.
 
 A result can also be handed to :func:`impstab.report` directly (``postcritical=``,
 ``statistics=``), computed with settings of one's own. When the provider does not exist, the

@@ -35,6 +35,7 @@ def report(
     steps: int = 200,
     postcritical=None,
     statistics=None,
+    target_margin: float | None = None,
     command: str | None = None,
 ) -> Report:
     """A self-contained HTML report of a model or a design study.
@@ -63,6 +64,9 @@ def report(
     postcritical, statistics : result, optional
         A post-critical result or study statistics computed beforehand (see
         :mod:`impstab.report.analyses`), shown instead of computing them.
+    target_margin : float, optional
+        Required margin of a sampled study: the statistics give the probability of a margin below
+        it; default 1 (an instability at the operating thrust), when the search reaches it.
     command : str, optional
         The command line to record in the provenance (the CLI passes its own).
 
@@ -77,8 +81,11 @@ def report(
         raise ModelError("duration", duration, "must be a finite number of seconds > 0")
     if not isinstance(steps, (int, np.integer)) or isinstance(steps, bool) or not 1 <= steps <= 100000:
         raise ModelError("steps", steps, "must be an integer between 1 and 100000")
+    if target_margin is not None and not (np.isfinite(float(target_margin)) and float(target_margin) > 0):
+        raise ModelError("target_margin", target_margin, "must be a finite number > 0")
     options = ReportOptions(simulation=bool(simulation), duration=None if duration is None else float(duration),
-                            frequencies=frequencies, steps=int(steps), postcritical=postcritical, statistics=statistics)
+                            frequencies=frequencies, steps=int(steps), postcritical=postcritical, statistics=statistics,
+                            target_margin=None if target_margin is None else float(target_margin))
     prov = make_provenance(origin, described, command or _python_call(source, path, sections, simulation))
     if kind == "model":
         ctx = ModelContext(obj, options)

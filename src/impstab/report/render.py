@@ -60,7 +60,7 @@ def render_page(**context) -> str:
 
     def block(b):
         if isinstance(b, Table):
-            return Markup('<div class="table-wrap">') + Markup(b.html) + Markup("</div>")
+            return Markup(f'<div class="table-wrap{" wide" if b.wide else ""}">') + Markup(b.html) + Markup("</div>")
         if isinstance(b, Figure):
             cap = Markup("<figcaption>{}</figcaption>").format(printable(b.caption)) if b.caption else Markup("")
             return Markup("<figure>") + Markup(b.svg) + cap + Markup("</figure>")

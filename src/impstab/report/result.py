@@ -27,9 +27,11 @@ class Figure:
 
 @dataclass(frozen=True)
 class Table:
-    """An HTML table whose cells were escaped where it was built (:func:`impstab.display.html.html_table`)."""
+    """An HTML table whose cells were escaped where it was built (:func:`impstab.display.html.html_table`);
+    ``wide`` gives it at least half the page's width (a long caption over few columns)."""
 
     html: str
+    wide: bool = False
 
 
 @dataclass(frozen=True)

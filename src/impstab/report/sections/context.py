@@ -26,6 +26,8 @@ class ReportOptions:
         Thrust intervals of the locus.
     postcritical, statistics : result objects or None
         Results computed beforehand, shown instead of calling the providers.
+    target_margin : float or None
+        Required margin of a study's statistics (None: 1, when the search reaches the operating thrust).
     """
 
     simulation: bool = True
@@ -34,6 +36,7 @@ class ReportOptions:
     steps: int = 200
     postcritical: object = None
     statistics: object = None
+    target_margin: float | None = None
 
 
 class ModelContext:

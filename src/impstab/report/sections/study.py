@@ -16,12 +16,10 @@ from ..analyses import find_provider
 from ..result import NOT_COMPUTED, Figure, Note, Section, Table
 from ..svg import draw_svg, mathtext_safe
 from ..tables import table
+from ...studies.statistics import SAMPLED
 
-__all__ = ["StudyContext", "study_section", "status_section", "maps_section", "best_section", "statistics_section",
-           "SAMPLED"]
+__all__ = ["StudyContext", "study_section", "status_section", "maps_section", "best_section", "statistics_section"]
 
-#: samplings whose designs are a sample of the input distribution (statistics apply)
-SAMPLED = ("random", "sobol", "saltelli")
 
 
 class StudyContext:
@@ -148,19 +146,12 @@ def best_section(ctx: StudyContext) -> Section:
             rows.append([what, "none", "", str(exc)])
             continue
         picks[what] = b
-        if b["lower_bound"]:
-            note = (f"censored: stable up to thrust_max, the true {by.replace('_', ' ')} is larger; "
-                    f"{b['tied']} designs share this bound and cannot be ranked (the first is shown)")
-            value = f">= {_value_text(by, b['value'])}"
-        else:
-            value = _value_text(by, b["value"])
-            note = f"{b['values'].get('kind', '')} at {number(b['values'].get('frequency_hz'), 4, 'Hz')}" \
-                if "frequency_hz" in b["values"] else str(b["values"].get("kind", ""))
-            if "where" in kw and n_censored:
-                note += (f"; {n_censored} censored designs left out are better (stable up to thrust_max): "
-                         "this is the best of the designs whose onset was found, not of the study")
-        if b.get("warning") and b["warning"] not in note:
-            note += f"; {b['warning']}"
+        value = (">= " if b["lower_bound"] else "") + _value_text(by, b["value"])
+        vals = b["values"]
+        note = "" if b["lower_bound"] else str(vals.get("kind", ""))
+        if note and "frequency_hz" in vals:
+            note += f" at {number(vals['frequency_hz'], 4, 'Hz')}"
+        note = "; ".join(t for t in (note, b.get("warning")) if t)      # best() says what a censored value means
         rows.append([what, value, _design_text(b["parameters"]), note])
     blocks: list = [table(f"best designs by {by.replace('_', ' ')}", rows, [by.replace("_", " "), "value", "design", "note"],
                           ["left", "right", "left", "left"])]
@@ -169,6 +160,50 @@ def best_section(ctx: StudyContext) -> Section:
                           f"{by.replace('_', ' ')} is only known to be at least the search limit. Raise "
                           "analysis.thrust_max to rank them."))
     return Section("best", "Best designs", blocks=tuple(blocks + notes), data={"best": picks, "by": by})
+
+
+def _statistics(provider, result, target: float | None) -> tuple[object, str]:
+    """The provider's statistics at the required margin, and a note of what had to be left out.
+
+    At the default margin 1 a study whose search ends below the operating thrust has no
+    probability to give (as ``impstab stats``); a study too small for sensitivity indices gets
+    its statistics without them, and the note says why.
+    """
+    from ...errors import ModelError
+
+    def compute(**kw):
+        if target is not None:
+            return provider(result, target, **kw)
+        try:
+            return provider(result, 1.0, **kw)
+        except ModelError as err:
+            if err.field != "--target-margin":
+                raise
+            return provider(result, None, **kw)
+
+    try:
+        return compute(), ""
+    except ModelError as err:
+        try:
+            stats = compute(sensitivity=False)
+        except (ModelError, TypeError):
+            raise err from None
+        return stats, f"sensitivity indices not computed: {err}"
+
+
+def _draw_statistics(stats):
+    """The statistics figure on the page's width: the distribution, its ECDF and (when computed)
+    the sensitivity indices one above the other, each panel as wide as the page (their legends
+    need the room)."""
+    import matplotlib.pyplot as plt
+
+    if not hasattr(stats, "main"):                       # another kind of statistics: its own figure
+        return stats.plot()
+    sens = getattr(stats, "sensitivity", None)
+    heights = [3.6, 3.6] + ([1.0 + 0.5 * len(getattr(sens, "parameters", ()))] if sens is not None else [])
+    fig, axes = plt.subplots(len(heights), 1, figsize=(8.4, sum(heights) + 0.3), layout="constrained",
+                             gridspec_kw={"height_ratios": heights})
+    return stats.plot(ax=list(axes))
 
 
 def statistics_section(ctx: StudyContext) -> Section:
@@ -182,13 +217,33 @@ def statistics_section(ctx: StudyContext) -> Section:
         provider, reason = find_provider("statistics")
         if provider is None:
             return Section("statistics", title, NOT_COMPUTED, reason)
-        stats = provider(ctx.result)
+        stats, left_out = _statistics(provider, ctx.result, ctx.options.target_margin)
+    else:
+        left_out = ""
     blocks: list = []
     if hasattr(stats, "summary_rows"):
         blocks.append(table("uncertainty statistics", stats.summary_rows(), ["quantity", "value"]))
     elif hasattr(stats, "_repr_html_"):
         blocks.append(Table(stats._repr_html_()))
+    if hasattr(stats, "percentiles"):
+        rows = []
+        for quantity in ("critical_thrust", "margin"):
+            if getattr(stats, quantity, None) is not None:
+                rows += [[quantity.replace("_", " "), f"{p.percent:g}", p.text(), p.interval_text()]
+                         for p in stats.percentiles(quantity)]
+        if rows:
+            level = getattr(stats, "confidence", 0.95)
+            blocks.append(table(f"percentiles with their {100 * level:g} % intervals", rows,
+                                ["quantity", "percent", "value", "interval"], ["left", "right", "right", "right"]))
+    sens = getattr(stats, "sensitivity", None)
+    if sens is not None and hasattr(sens, "_repr_html_"):
+        blocks.append(Table(sens._repr_html_(), wide=True))
     if hasattr(stats, "plot"):
-        blocks.append(Figure(draw_svg(stats.plot, "statistics"),
-                             "Distribution of the critical thrust and the margin; censored designs apart."))
+        blocks.append(Figure(draw_svg(lambda: _draw_statistics(stats), "statistics"),
+                             "Distribution of the critical thrust or margin over the computed designs (censored "
+                             "designs apart), its empirical distribution function with the confidence band, and "
+                             "the sensitivity indices when computed."))
+    blocks += [Note(str(n)) for n in getattr(stats, "notes", ())]
+    if left_out:
+        blocks.append(Note(left_out))
     return Section("statistics", title, blocks=tuple(blocks), data={"statistics": stats})
