@@ -31,6 +31,27 @@ _FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no
           "--disable-dev-shm-usage", "--hide-scrollbars")
 
 
+class _Screenshots:
+    """A plugin that lists the screenshots taken at the end of the test run."""
+
+    def __init__(self) -> None:
+        self.paths: list[str] = []
+
+    def pytest_terminal_summary(self, terminalreporter):
+        if self.paths:
+            terminalreporter.section("report screenshots")
+            for path in self.paths:
+                terminalreporter.write_line(path)
+
+
+@pytest.fixture(scope="module")
+def screenshot_log(request):
+    """Append a screenshot's path to have it printed in the test summary."""
+    plugin = _Screenshots()
+    request.config.pluginmanager.register(plugin, "impstab-report-screenshots")
+    return plugin.paths
+
+
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory):
     from selenium import webdriver

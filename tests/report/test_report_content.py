@@ -473,3 +473,35 @@ def test_statistics_of_a_sampled_study(tmp_path):
     assert "percentiles with their 95 % intervals" in rep.html
     assert "sensitivity indices not computed: STORE = '12 computed designs': too few" in page_text(rep.html)
     assert rep.section("best").status == "computed"
+
+
+def test_a_divergence_onset_has_no_time_histories(tmp_path):
+    """A fixed-direction thrust buckles the layout: a divergence, where the static equilibrium is
+    singular (Newton fails there) and past which a real eigenvalue grows (no oscillation)."""
+    text = copy_example(tmp_path, "imp_symmetric.toml").read_text(encoding="utf-8")
+    path = write_model(tmp_path, "fixed.toml", text.replace("tangency = 1.0 ", "tangency = 0.0 "))
+    rep = impstab.report(path, sections=["stability", "simulation"])
+    crit = rep.section("stability").data["critical"]
+    assert crit.kind == "divergence"
+    model = impstab.load_model(path)
+    with pytest.raises(impstab.NumericalError, match="no static equilibrium"):
+        impstab.linearize(model, crit.thrust)
+    lam = np.linalg.eigvals(impstab.linearize(model, 1.05 * crit.thrust).state_matrix())
+    growing = lam[lam.real > 1e-6 * np.abs(lam).max()]
+    assert growing.size and np.all(np.abs(growing.imag) < 1e-9 * np.abs(lam).max())
+    sec = rep.section("simulation")
+    assert sec.status == "not computed" and "divergence" in sec.reason
+
+
+def test_a_failed_section_keeps_its_title_and_the_others(tmp_path, monkeypatch):
+    from impstab.report.sections import MODEL_SECTIONS
+
+    def broken(ctx):
+        raise ValueError("broken <b>")
+
+    monkeypatch.setitem(MODEL_SECTIONS, "locus", broken)
+    rep = impstab.report(copy_example(tmp_path, "imp_symmetric.toml"), sections=["stability", "locus"])
+    sec = rep.section("locus")
+    assert (sec.status, sec.title, sec.reason) == ("failed", "Eigenvalue loci", "ValueError: broken <b>")
+    assert rep.section("stability").status == "computed"
+    assert "Failed:</strong> ValueError: broken &lt;b&gt;" in rep.html

@@ -48,7 +48,9 @@ def find_provider(section: str) -> tuple[Callable | None, str]:
     module, _, attr = name.partition(":")
     try:
         func = getattr(import_module(module), attr, None)
-    except ModuleNotFoundError:
+    except ModuleNotFoundError as exc:
+        if exc.name is None or not (module == exc.name or module.startswith(exc.name + ".")):
+            raise                      # the module exists but lacks one of its own imports: say so
         func = None
     if func is None:
         return None, _ABSENT[section].format(name=name.replace(":", "."))

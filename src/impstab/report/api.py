@@ -13,7 +13,7 @@ from ..errors import ModelError
 from .provenance import make_provenance
 from .render import printable, render_page
 from .result import COMPUTED, FAILED, Report, Section
-from .sections import MODEL_SECTIONS, STUDY_SECTIONS, ModelContext, ReportOptions, StudyContext
+from .sections import MODEL_SECTIONS, STUDY_SECTIONS, TITLES, ModelContext, ReportOptions, StudyContext
 from .tables import table
 
 __all__ = ["report", "SECTION_NAMES"]
@@ -83,6 +83,10 @@ def report(
         raise ModelError("steps", steps, "must be an integer between 1 and 100000")
     if target_margin is not None and not (np.isfinite(float(target_margin)) and float(target_margin) > 0):
         raise ModelError("target_margin", target_margin, "must be a finite number > 0")
+    if frequencies is not None:
+        from ..response.api import check_frequencies
+
+        frequencies = check_frequencies(frequencies)
     options = ReportOptions(simulation=bool(simulation), duration=None if duration is None else float(duration),
                             frequencies=frequencies, steps=int(steps), postcritical=postcritical, statistics=statistics,
                             target_margin=None if target_margin is None else float(target_margin))
@@ -184,8 +188,7 @@ def _build(builder, ctx, name: str) -> Section:
     try:
         return builder(ctx)
     except Exception as exc:  # noqa: BLE001 - a report shows a failed analysis instead of losing the others
-        title = {"summary": "Model"}.get(name, name.replace("_", " ").capitalize())
-        return Section(name, title, FAILED, printable(f"{type(exc).__name__}: {exc}"))
+        return Section(name, TITLES.get(name, name), FAILED, printable(f"{type(exc).__name__}: {exc}"))
 
 
 def _python_call(source, path, sections, simulation) -> str:

@@ -6,6 +6,7 @@ the input returns a section marked "not computed" with the reason.
 """
 
 from .context import ModelContext, ReportOptions
+from .titles import TITLES
 from .isolation import isolation_section
 from .model import modes_section, static_section, summary_section
 from .postcritical import postcritical_section
@@ -13,7 +14,7 @@ from .simulation import simulation_section
 from .stability import locus_section, stability_section
 from .study import StudyContext, best_section, maps_section, statistics_section, status_section, study_section
 
-__all__ = ["MODEL_SECTIONS", "STUDY_SECTIONS", "ModelContext", "StudyContext", "ReportOptions"]
+__all__ = ["MODEL_SECTIONS", "STUDY_SECTIONS", "TITLES", "ModelContext", "StudyContext", "ReportOptions"]
 
 #: sections of a model report, in page order
 MODEL_SECTIONS = {

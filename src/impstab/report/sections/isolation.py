@@ -16,6 +16,7 @@ from ...display.format import number
 from ..result import Figure, Note, Section
 from ..svg import draw_svg
 from ..tables import table
+from .titles import TITLES
 from .context import ModelContext
 
 __all__ = ["isolation_section", "default_frequencies", "POINTS", "BAND_BELOW", "BAND_ABOVE"]
@@ -85,7 +86,7 @@ def isolation_section(ctx: ModelContext) -> Section:
     else:
         blocks += _excitation_blocks(ex)
         data["excitation"] = ex
-    return Section("isolation", "Vibration isolation", blocks=tuple(blocks), data=data)
+    return Section("isolation", TITLES["isolation"], blocks=tuple(blocks), data=data)
 
 
 def _excitation_blocks(ex) -> list:

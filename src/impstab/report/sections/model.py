@@ -7,6 +7,7 @@ import numpy as np
 from ...display.format import number
 from ..result import NOT_COMPUTED, Note, Section, Table
 from ..tables import table
+from .titles import TITLES
 from .context import ModelContext
 
 __all__ = ["summary_section", "static_section", "modes_section", "mount_rows"]
@@ -78,13 +79,13 @@ def summary_section(ctx: ModelContext) -> Section:
         rows.append(("excitation", "none ([excitation] has no loads)"))
     rows.append(("foundation", "rigid hull" if m.foundation.model == "rigid" else f"{m.foundation.model} point impedance"))
     blocks.append(table("further settings", rows))
-    return Section("summary", "Model", blocks=tuple(blocks), data={"model": m})
+    return Section("summary", TITLES["summary"], blocks=tuple(blocks), data={"model": m})
 
 
 def static_section(ctx: ModelContext) -> Section:
     from ...response.static import static_mount_loads
 
-    title = "Static deflection and mount loads"
+    title = TITLES["static"]
     if not ctx.operating:
         return Section("static", title, NOT_COMPUTED, "the model gives no operating thrust (thrust.operating)")
     st = static_mount_loads(ctx.model)
@@ -136,5 +137,5 @@ def modes_section(ctx: ModelContext) -> Section:
         Note("Shares in mass-centre coordinates (a rotation about the cg counts as rotation); each row sums to 100."),
         table(f"decoupling at {where}", findings),
     ]
-    return Section("modes", f"Modes and decoupling at {where}", blocks=tuple(blocks),
+    return Section("modes", f"{TITLES['modes']} at {where}", blocks=tuple(blocks),
                    data={"modal": md, "decoupling": check})

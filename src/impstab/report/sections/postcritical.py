@@ -17,6 +17,7 @@ from ..analyses import find_provider
 from ..result import NOT_COMPUTED, Figure, Note, Section
 from ..svg import draw_svg
 from ..tables import table
+from .titles import TITLES
 from .context import ModelContext
 
 __all__ = ["postcritical_section", "postcritical_blocks", "READING"]
@@ -29,7 +30,7 @@ READING = {
     "degenerate": "the plain Hopf theory does not apply at this onset (see the reason)",
 }
 
-TITLE = "Post-critical behaviour"
+TITLE = TITLES["postcritical"]
 
 
 def postcritical_blocks(result) -> list:

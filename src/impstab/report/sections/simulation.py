@@ -22,6 +22,7 @@ from ...display.format import growth, number
 from ..result import NOT_COMPUTED, Figure, Note, Section
 from ..svg import draw_svg, mathtext_safe
 from ..tables import table
+from .titles import TITLES
 from .context import ModelContext
 
 __all__ = ["simulation_section", "THRUST_FACTORS", "GROWTH_FOLDS", "MIN_PERIODS", "MAX_PERIODS", "run_settings"]
@@ -34,8 +35,6 @@ GROWTH_FOLDS = 3.0
 MIN_PERIODS, MAX_PERIODS = 40, 400
 #: growth over a run (e-foldings of the supercritical linear rate) below which it is invisible and said so
 WEAK_GROWTH = 0.1
-#: default length (s) when the onset is a divergence (no frequency)
-DIVERGENCE_DURATION = 5.0
 _KINDS = ("subcritical", "at the critical thrust", "supercritical")
 
 
@@ -45,18 +44,19 @@ def run_settings(ctx: ModelContext) -> tuple[list[float], float] | str:
     if crit.thrust is None:
         return (f"no critical thrust up to thrust_max = {number(crit.thrust_max)} N: there is no sub-, at- and "
                 "supercritical triple to show")
+    if crit.kind == "divergence":
+        return (f"the onset is a divergence (a static instability at {number(crit.thrust)} N): the equilibrium the "
+                "runs start from is singular there and unstable beyond, the motion a static collapse, not an "
+                "oscillation; the sub-, at- and supercritical time histories are shown for a flutter onset")
     thrusts = [factor * crit.thrust for factor in THRUST_FACTORS]
     duration = ctx.options.duration
     if duration is None:
-        f = crit.frequency_hz
-        if not f:
-            duration = DIVERGENCE_DURATION
-        else:
-            from ...linear.modes import modes
+        from ...linear.modes import modes
 
-            rate = float(np.max(modes(ctx.model, thrusts[-1]).growth_rate))
-            grow = GROWTH_FOLDS / rate if rate > 0 else math.inf
-            duration = min(max(grow, MIN_PERIODS / f), MAX_PERIODS / f)
+        f = crit.frequency_hz                     # a flutter onset: a frequency > 0
+        rate = float(np.max(modes(ctx.model, thrusts[-1]).growth_rate))
+        grow = GROWTH_FOLDS / rate if rate > 0 else math.inf
+        duration = min(max(grow, MIN_PERIODS / f), MAX_PERIODS / f)
     return thrusts, float(duration)
 
 
@@ -79,7 +79,7 @@ def _draw(runs):
 def simulation_section(ctx: ModelContext) -> Section:
     from ...dynamics.simulate import default_step, simulate
 
-    title = "Time histories below, at and above the critical thrust"
+    title = TITLES["simulation"]
     if not ctx.options.simulation:
         return Section("simulation", title, NOT_COMPUTED, "left out of this report: no time histories asked for "
                                                           "(--no-simulation; simulation=False in Python)")

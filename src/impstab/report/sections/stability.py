@@ -8,6 +8,7 @@ from ...display.format import number
 from ..result import Figure, Note, Section, Table
 from ..svg import draw_svg, mathtext_safe
 from ..tables import table
+from .titles import TITLES
 from .context import ModelContext
 
 __all__ = ["stability_section", "locus_section", "damping_note"]
@@ -51,7 +52,7 @@ def stability_section(ctx: ModelContext) -> Section:
         blocks.append(Note(f"the margin {number(crit.margin, 4)} is below 1: the propulsor is unstable at its "
                            "operating thrust", "warning"))
     blocks += [Note(w, "warning") for w in crit.warnings]
-    return Section("stability", "Critical thrust and margin", blocks=tuple(blocks), data={"critical": crit})
+    return Section("stability", TITLES["stability"], blocks=tuple(blocks), data={"critical": crit})
 
 
 def locus_section(ctx: ModelContext) -> Section:
@@ -64,5 +65,5 @@ def locus_section(ctx: ModelContext) -> Section:
                f"branch, named by its dominant dofs; {loc.thrust.size} thrusts from {number(loc.thrust[0])} to "
                f"{number(loc.thrust[-1])} N. Dashed: the onset; dash-dotted: the undamped onset; dotted: the "
                "operating thrust.")
-    return Section("locus", "Eigenvalue loci", blocks=(Figure(svg, caption), Table(locus_html(loc))),
+    return Section("locus", TITLES["locus"], blocks=(Figure(svg, caption), Table(locus_html(loc))),
                    data={"locus": loc})

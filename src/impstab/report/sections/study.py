@@ -16,6 +16,7 @@ from ..analyses import find_provider
 from ..result import NOT_COMPUTED, Figure, Note, Section, Table
 from ..svg import draw_svg, mathtext_safe
 from ..tables import table
+from .titles import TITLES
 from ...studies.statistics import SAMPLED
 
 __all__ = ["StudyContext", "study_section", "status_section", "maps_section", "best_section", "statistics_section"]
@@ -72,7 +73,7 @@ def study_section(ctx: StudyContext) -> Section:
             ("computed by", f"impstab {a.get('impstab_version', 'unknown')}")]
     rows += [(f"parameter {k + 1}", f"{p}: {label(p)}") for k, p in enumerate(ctx.result.parameters)]
     blocks = [Table(study_html(ctx.result)), table("study settings", rows)]
-    return Section("study", "Design study", blocks=tuple(blocks), data={"study": ctx.result})
+    return Section("study", TITLES["study"], blocks=tuple(blocks), data={"study": ctx.result})
 
 
 def status_section(ctx: StudyContext) -> Section:
@@ -97,7 +98,7 @@ def status_section(ctx: StudyContext) -> Section:
     if counts.get("not_computed"):
         blocks.append(Note(f"{counts['not_computed']} designs are not computed yet: rerun `impstab sweep` to "
                            "resume the study.", "warning"))
-    return Section("status", "Designs by status", blocks=tuple(blocks), data={"counts": counts})
+    return Section("status", TITLES["status"], blocks=tuple(blocks), data={"counts": counts})
 
 
 def maps_section(ctx: StudyContext) -> Section:
@@ -105,7 +106,7 @@ def maps_section(ctx: StudyContext) -> Section:
     drawn = ctx.for_drawing()
     values = [v for v in ("critical_thrust", "margin") if v in ds.data_vars]
     if not values:
-        return Section("maps", "Stability maps", NOT_COMPUTED,
+        return Section("maps", TITLES["maps"], NOT_COMPUTED,
                        "the study stores neither critical_thrust nor margin (its outputs)")
     params = ctx.result.parameters
     if "sample" in ds.dims:
@@ -123,7 +124,7 @@ def maps_section(ctx: StudyContext) -> Section:
     for v in values:
         svg = draw_svg(lambda v=v: drawn.plot(value=v), f"map-{v.replace('_', '-')}")
         blocks.append(Figure(svg, f"{v.replace('_', ' ')}: {how}."))
-    return Section("maps", "Stability maps", blocks=tuple(blocks))
+    return Section("maps", TITLES["maps"], blocks=tuple(blocks))
 
 
 def best_section(ctx: StudyContext) -> Section:
@@ -132,7 +133,7 @@ def best_section(ctx: StudyContext) -> Section:
     # the margin when the designs have an operating thrust to measure it against
     by = "margin" if "margin" in ds.data_vars and res.search_limit("margin") is not None else "critical_thrust"
     if by not in ds.data_vars:
-        return Section("best", "Best designs", NOT_COMPUTED, "the study stores neither margin nor critical_thrust")
+        return Section("best", TITLES["best"], NOT_COMPUTED, "the study stores neither margin nor critical_thrust")
     censored = (ds["kind"].values == 0) & (ds["status"].values == 0) if "kind" in ds else np.zeros(ds[by].shape, bool)
     n_censored = int(np.count_nonzero(censored))
     rows, notes, picks = [], [], {}
@@ -159,7 +160,7 @@ def best_section(ctx: StudyContext) -> Section:
         notes.append(Note(f"{n_censored} of {int(ds['status'].size)} designs are stable up to thrust_max: their "
                           f"{by.replace('_', ' ')} is only known to be at least the search limit. Raise "
                           "analysis.thrust_max to rank them."))
-    return Section("best", "Best designs", blocks=tuple(blocks + notes), data={"best": picks, "by": by})
+    return Section("best", TITLES["best"], blocks=tuple(blocks + notes), data={"best": picks, "by": by})
 
 
 def _statistics(provider, result, target: float | None) -> tuple[object, str]:
@@ -207,7 +208,7 @@ def _draw_statistics(stats):
 
 
 def statistics_section(ctx: StudyContext) -> Section:
-    title = "Uncertainty statistics"
+    title = TITLES["statistics"]
     stats = ctx.options.statistics
     if stats is None:
         if ctx.sampling not in SAMPLED:
