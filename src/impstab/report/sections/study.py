@@ -61,17 +61,13 @@ def _design_text(parameters: dict) -> str:
 
 def study_section(ctx: StudyContext) -> Section:
     from ...display.html import study_html
-    from ...model.reference import label
 
-    ds = ctx.dataset
-    a = ds.attrs
-    rows = [("sampling", ctx.sampling), ("designs", str(int(ds["status"].size))),
-            ("outputs", ", ".join(json.loads(a.get("outputs", "[]")))),
+    a = ctx.dataset.attrs
+    rows = [("outputs", ", ".join(json.loads(a.get("outputs", "[]")))),
             ("base model", f"{a.get('model_name', '')} ({a.get('model_path', '')})"),
             ("study file", str(a.get("study_path", ""))),
             ("created", str(a.get("created", ""))), ("completed", str(a.get("completed", "not complete"))),
             ("computed by", f"impstab {a.get('impstab_version', 'unknown')}")]
-    rows += [(f"parameter {k + 1}", f"{p}: {label(p)}") for k, p in enumerate(ctx.result.parameters)]
     blocks = [Table(study_html(ctx.result)), table("study settings", rows)]
     return Section("study", TITLES["study"], blocks=tuple(blocks), data={"study": ctx.result})
 
