@@ -40,14 +40,14 @@ _LAZY = {
     "frequency_response": ("response", "frequency_response"),
     "excitation_response": ("response", "excitation_response"),
 }
-__all__ += ["frequency_response", "excitation_response"]
+__all__ += ["frequency_response", "excitation_response", "report"]
 
 
 def __getattr__(name: str):
-    if name == "fluid":
+    if name in ("fluid", "report"):  # subpackages (impstab.report is callable: impstab.report(path, ...))
         from importlib import import_module
 
-        return import_module(".fluid", __name__)
+        return import_module(f".{name}", __name__)
     if name in _LAZY:
         from importlib import import_module
 

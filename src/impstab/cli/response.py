@@ -31,18 +31,6 @@ def _frequencies(spec: str) -> np.ndarray:
     return parse_frequencies(spec, MAX_FREQUENCIES)
 
 
-def _isolation_onset(f: np.ndarray, t: np.ndarray) -> float | None:
-    """Lowest frequency above which the transmissibility stays below 1 up to the range end (Hz)."""
-    above = np.flatnonzero(~(t < 1.0))
-    if above.size == 0:
-        return float(f[0])
-    last = above[-1]
-    if last == f.size - 1:
-        return None
-    t0, t1 = np.log(t[last]), np.log(t[last + 1])
-    return float(f[last] + (f[last + 1] - f[last]) * t0 / (t0 - t1)) if t0 != t1 else float(f[last + 1])
-
-
 def _summary(res, model_name: str) -> None:
     from rich.table import Table
 
@@ -56,7 +44,7 @@ def _summary(res, model_name: str) -> None:
     t.add_row("frequencies", f"{f.size} from {f[0]:g} to {f[-1]:g} Hz")
     j = int(np.nanargmax(tr))
     t.add_row("peak transmissibility", f"{tr[j]:.5g} {unit} ({20 * np.log10(tr[j]):.2f} dB) at {f[j]:.5g} Hz")
-    onset = _isolation_onset(f, tr) if kind == "force" else None
+    onset = res.isolation_frequency_hz() if kind == "force" else None
     if kind == "force":
         t.add_row("isolation (transmissibility < 1) from", "not reached in the range" if onset is None else f"{onset:.5g} Hz")
     t.add_row(f"transmissibility at {f[-1]:g} Hz", f"{tr[-1]:.5g} {unit} ({20 * np.log10(tr[-1]):.2f} dB)")

@@ -10,10 +10,10 @@ import math
 
 import numpy as np
 
-from .format import growth, number
+from .format import growth, number, signed_zero_free
 
 __all__ = ["model_html", "critical_html", "modal_html", "locus_html", "simulation_html", "study_html",
-           "batch_html", "html_table"]
+           "batch_html", "html_table", "modal_columns", "modal_title"]
 
 _STYLE = ("border-collapse:collapse;font-size:0.9em;margin:0.3em 0;"
           "font-variant-numeric:tabular-nums")
@@ -80,7 +80,9 @@ def critical_html(c) -> str:
     return html_table(f"critical thrust of {c.model_name}" if c.model_name else "critical thrust", critical_rows(c))
 
 
-def modal_html(r) -> str:
+def modal_columns(r) -> tuple[list[str], list[list[str]], list[str]]:
+    """Header, rows and alignment of the modes table: mode, frequency, damping, growth, dominant
+    dofs, then the kinetic-energy share of each dof (the decoupling table, % per mode)."""
     from ..model.model import DOF_NAMES
 
     scale = float(np.abs(r.eigenvalues).max(initial=0.0))
@@ -91,10 +93,18 @@ def modal_html(r) -> str:
         zeta = "0" if abs(r.growth_rate[j]) < 1e-10 * max(scale, 1e-300) else number(r.damping_ratio[j], 4)
         rows.append([str(j + 1), number(r.frequency_hz[j]), number(r.omega[j]), zeta,
                      growth(r.growth_rate[j], scale), ", ".join(dom),
-                     *(f"{100 * v:.1f}" for v in r.participation[j])])
+                     *(signed_zero_free(f"{100 * v:.1f}") for v in r.participation[j])])
     align = ["right"] * 5 + ["left"] + ["right"] * 6
-    title = f"modes at T = {number(r.thrust)} N ({r.linearization} linearization): " + ("stable" if r.stable else "UNSTABLE")
-    return html_table(title, rows, header, align)
+    return header, rows, align
+
+
+def modal_title(r) -> str:
+    return f"modes at T = {number(r.thrust)} N ({r.linearization} linearization): " + ("stable" if r.stable else "UNSTABLE")
+
+
+def modal_html(r) -> str:
+    header, rows, align = modal_columns(r)
+    return html_table(modal_title(r), rows, header, align)
 
 
 def locus_html(r) -> str:

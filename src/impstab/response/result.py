@@ -150,6 +150,25 @@ class ForcedResponse:
         return (self.power_input + self.power_thrust - self.power_fluid - self.power_damper.sum(axis=-1)
                 - self.power_transmitted.sum(axis=-1))
 
+    def isolation_frequency_hz(self) -> float | None:
+        """Lowest frequency (Hz) above which the transmissibility stays below 1 up to the end of
+        the range, interpolated in log transmissibility between samples; the first frequency
+        when it is below 1 everywhere; None when it is not below 1 at the end of the range.
+
+        Meaningful for a force input (N/N); None for an excitation (no transmissibility).
+        """
+        if not self.is_transfer:
+            return None
+        f, t = self.frequency_hz, self.transmissibility
+        above = np.flatnonzero(~(t < 1.0))
+        if above.size == 0:
+            return float(f[0])
+        last = above[-1]
+        if last == f.size - 1:
+            return None
+        t0, t1 = np.log(t[last]), np.log(t[last + 1])
+        return float(f[last] + (f[last + 1] - f[last]) * t0 / (t0 - t1)) if t0 != t1 else float(f[last + 1])
+
     def bands(self) -> BandLevels:
         """One-third-octave band levels of the hull force (dB re 1 N) of an excitation's lines."""
         return band_levels(self.frequency_hz, self.hull_force)
