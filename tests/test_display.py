@@ -93,7 +93,7 @@ def test_batch_result_views():
     from conftest import ring_model_dict
     from impstab.linear.batch import critical_thrust_batch
 
-    models = [model_from_dict(ring_model_dict()), model_from_dict(ring_model_dict(analysis={"thrust_max": 1000.0}))]
+    models = [model_from_dict(ring_model_dict()), model_from_dict(ring_model_dict(analysis={"thrust_max": 1000.0}, thrust={"operating": 500.0}))]
     res = critical_thrust_batch(models)
     text = repr(res)
     assert text.startswith("BatchCriticalThrust(2 designs: none 1, flutter 1, failed 0")

@@ -4,6 +4,8 @@ import numpy as np
 import pytest
 from scipy import special
 
+import impstab.fluid as fl
+from impstab.fluid.integrals import window_integrals
 from impstab.fluid.impedance import evanescent_ratio, incompressible_kernel, modal_impedance, radiating_ratio
 from impstab.fluid.quadrature import PanelRule, graded_edges, split_long
 from impstab.fluid.windows import window_parts, window_squared
@@ -98,3 +100,27 @@ def test_modal_impedance_continuous_at_k0(k0a):
     z = modal_impedance(np.linspace(0, 3 * k0, 301), a, rho, c, omega)
     assert np.all(z.real >= 0) and np.all(z.imag > 0)
     assert np.all(z[np.linspace(0, 3 * k0, 301) > k0].real == 0)
+
+
+@pytest.mark.parametrize("ell,s0", [(1e-7, 0.0), (1e-3, 0.5), (2.67, 0.0), (2.67, 1.0), (100.0, 0.0), (2.67, 300.0),
+                                    (1e3, 0.0), (10.0, 10.0)])
+@pytest.mark.parametrize("refine", [1, 2, 4])
+def test_node_estimate_bounds_the_layout(ell, s0, refine):
+    """The O(1) estimate used to refuse work is an upper bound of the nodes the layout really has,
+    and a tight one (within 20 %)."""
+    from impstab.fluid.integrals import estimate_nodes
+
+    actual = window_integrals(ell, s0, refine).nodes
+    assert actual <= estimate_nodes(ell, s0, refine) <= 1.2 * actual
+
+
+def test_too_much_quadrature_is_refused_before_it_starts():
+    from impstab.errors import ModelError
+
+    with pytest.raises(ModelError, match="^length = 1000.0: .*quadrature nodes"):
+        fl.baffled_cylinder(radius=1e-4, length=1000.0)
+    with pytest.raises(ModelError, match="^frequency = 1000000.0: the segment is .* wavelengths long"):
+        fl.baffled_cylinder(radius=1.0, length=1000.0, sound_speed=1.0, frequency=1e6)
+    # just inside the limit it runs
+    assert fl.quadrature_nodes(0.15, 0.8, 1500.0, 1e6) <= 1_000_000
+    assert fl.baffled_cylinder(radius=0.15, length=0.8, sound_speed=1500.0, frequency=1e6).added_mass > 0

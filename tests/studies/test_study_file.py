@@ -108,7 +108,7 @@ BAD = [
     ("", 'path = "body.cg"\nvalues = [0.1]', "parameters[0].path", "not one value"),
     ("", 'path = "mount_rings.x"\nvalues = [0.1]', "parameters[0].path", "is a list"),
     ("", 'path = "mount_rings[0].x"\nvalues = { start = 0.1, stop = 0.4 }', "parameters[0].values.num", "required"),
-    ("", 'path = "mount_rings[0].k_shear"\nvalues = [-1.0, 1e4]', "parameters[0].values", "greater than or equal to 0"),
+    ("", 'path = "mount_rings[0].k_shear"\nvalues = [-1.0, 1e4]', "parameters[0].values", "must be between 0 and 1e+13 N/m"),
     ("", 'path = "mount_rings[0].count"\nvalues = { start = 1, stop = 2, num = 3 }', "parameters[0].values", "integer"),
     ("", 'path = "mount_rings[0].x"\nvalues = { start = 0.0, stop = 0.4, num = 3, scale = "log" }', "parameters[0].values", "> 0"),
     ("", 'path = "mount_rings[0].x"\ndistribution = { kind = "normal", mean = 0.3, std = 0.01 }', "parameters[0].distribution", "random"),
@@ -116,6 +116,22 @@ BAD = [
     ('[sampling]\nmethod = "sobol"\nn = 8', 'path = "mount_rings[0].x"\ndistribution = { kind = "normal", mean = 0.3 }', "parameters[0].distribution", "std"),
     ('outputs = ["critical_thrustt"]', 'path = "mount_rings[0].x"\nvalues = [0.1]', "outputs[0]", "critical_thrust"),
     ("", 'path = "mount_rings[0].x"\nvalues = [0.1, 0.1]', "parameters[0].values", "distinct"),
+    # strict types: the variants are checked with the model file's own strict rules
+    ("", 'path = "mount_rings[0].k_shear"\nvalues = [true, false]', "parameters[0].values", "not a boolean"),
+    ("", 'path = "body.mass"\nvalues = ["100", "200"]', "parameters[0].values", "not a string"),
+    ("", 'path = "mount_rings[0].count"\nvalues = [3.0, 4.0]', "parameters[0].values", "write 3, not 3.0"),
+    ("", 'path = "thrust.preload_stiffness"\nvalues = [1, 0]', "parameters[0].values", "true or false"),
+    ("", 'path = "body.cg[0]"\nvalues = [0.0, 1e200]', "parameters[0].values", "between -1000 and 1000 m"),
+    ("", 'path = "mount_rings[0].x"\nvalues = { start = 0.1, stop = 0.4, num = 3.0 }', "parameters[0].values.num", "integer"),
+    ("", 'path = "mount_rings[0].x"\nvalues = { start = true, stop = 0.4, num = 3 }', "parameters[0].values.start", "boolean"),
+    ('[sampling]\nmethod = "random"\nn = 8\nseed = 1.5', 'path = "mount_rings[0].x"\nvalues = { start = 0.1, stop = 0.4 }',
+     "sampling.seed", "integer"),
+    # a normal distribution reaches negative stiffnesses: refused before anything runs
+    ('[sampling]\nmethod = "random"\nn = 64', 'path = "mount_rings[0].k_shear"\ndistribution = { kind = "normal", mean = 1e3, std = 1e3 }',
+     "parameters[0].distribution", "between 0 and 1e+13 N/m"),
+    # results too large for memory, estimated before anything runs
+    ("", 'path = "mount_rings[0].x"\nvalues = { start = 0.1, stop = 0.4, num = 10000 }\n[[parameters]]\n'
+         'path = "mount_rings[0].k_shear"\nvalues = { start = 1e4, stop = 1e5, num = 10000 }', "parameters", "GiB"),
 ]
 
 
@@ -145,6 +161,8 @@ def test_bad_study_file_names_the_field(tmp_path, capsys, header, param, field, 
     "change,field",
     [
         (lambda t: t.replace("schema_version = 1", "schema_version = 2"), "schema_version"),
+        (lambda t: t.replace("schema_version = 1", "schema_version = 1.0"), "schema_version"),
+        (lambda t: t.replace("schema_version = 1", 'schema_version = "1"'), "schema_version"),
         (lambda t: t.replace('model = "imp_symmetric.toml"', 'model = "missing.toml"'), "model"),
         (lambda t: t + "\n[parameters\n", "study file"),
     ],

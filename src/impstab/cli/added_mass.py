@@ -8,7 +8,8 @@ import click
 import numpy as np
 
 from ..errors import ModelError
-from ._common import check_number, console, fmt, print_json, table
+from ..limits import LONG_FACTOR, MAX_FREQUENCIES, MAX_SWEEP_NODES, RANGES, describe_count
+from ._common import check_number, check_output, console, fmt, print_json, table
 
 __all__ = ["commands", "parse_frequencies"]
 
@@ -16,18 +17,31 @@ _FLAGS = {"radius": "--radius", "length": "--length", "density": "--density",
           "sound_speed": "--sound-speed", "frequency": "--frequency", "frequencies": "--frequencies"}
 
 
-def parse_frequencies(spec: str) -> np.ndarray:
-    """``"START:STOP:NUM"`` -> ``NUM`` equally spaced frequencies from START to STOP (Hz, inclusive)."""
+def parse_frequencies(spec: str, max_count: int = MAX_FREQUENCIES) -> np.ndarray:
+    """``"START:STOP:NUM"`` -> ``NUM`` equally spaced frequencies from START to STOP (Hz, inclusive).
+
+    NUM is at most ``max_count``; START and STOP lie in the frequency range of
+    :data:`impstab.limits.RANGES` (checked before the frequencies are made).
+    """
     rule = "must be START:STOP:NUM (Hz, 0 <= START <= STOP, NUM an integer >= 1)"
     parts = spec.split(":")
     if len(parts) != 3:
         raise ModelError("--frequencies", spec, rule)
     try:
-        start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
+        start, stop, count = float(parts[0]), float(parts[1]), float(parts[2])
     except ValueError:
         raise ModelError("--frequencies", spec, rule) from None
+    if not (np.isfinite(count) and count.is_integer()):
+        raise ModelError("--frequencies", spec, rule)
+    num = int(count)
     if not (np.isfinite(start) and np.isfinite(stop) and 0.0 <= start <= stop and num >= 1):
         raise ModelError("--frequencies", spec, rule)
+    band = RANGES["frequency"]
+    if stop > band.high:
+        raise ModelError("--frequencies", spec, f"START and STOP {band.rule()[5:]}")
+    if num > max_count:
+        raise ModelError("--frequencies", spec, f"NUM must be at most {max_count} frequencies"
+                         + ("" if max_count > MAX_FREQUENCIES else f" (--allow-long: {MAX_FREQUENCIES * LONG_FACTOR})"))
     if num == 1 and start != stop:
         raise ModelError("--frequencies", spec, "NUM = 1 needs START = STOP")
     return np.linspace(start, stop, num)
@@ -103,9 +117,12 @@ def _progress(values):
               help="With --frequencies: plot the coefficients against frequency to this figure "
                    "(.png, .svg or .pdf), or write them to a netCDF file (.nc).")
 @click.option("--dpi", type=float, default=None, help="Resolution of a PNG figure (default 150).")
+@click.option("--allow-long", is_flag=True,
+              help=f"allow sweeps beyond {MAX_FREQUENCIES} frequencies or {MAX_SWEEP_NODES:.0e} quadrature nodes "
+                   f"(up to {LONG_FACTOR} times more), with a progress bar on a terminal")
 def added_mass_cmd(radius: float, length: float, density: float, sound_speed: float | None,
                    frequency: float, frequencies: str | None, as_json: bool, output: str | None,
-                   dpi: float | None) -> None:
+                   dpi: float | None, allow_long: bool) -> None:
     """Added mass, added inertia and radiation resistance of a cylinder segment in a baffle.
 
     Coefficients are for transverse motion about the segment centre (SI units, frequency in Hz).
@@ -127,10 +144,23 @@ def added_mass_cmd(radius: float, length: float, density: float, sound_speed: fl
         from ..plot.save import check_figure_path
 
         check_figure_path(output)
-    check_number("--dpi", dpi, positive=True)
-    grid = parse_frequencies(frequencies)
-    # validate the geometry before a long sweep starts
+    if output is not None:
+        check_output("--output", output)
+    check_number("--dpi", dpi, kind="dpi")
+    grid = parse_frequencies(frequencies, MAX_FREQUENCIES * (LONG_FACTOR if allow_long else 1))
+    # validate the geometry and the work before a long sweep starts
     _with_flag_names(fluid.baffled_cylinder, radius, length, density, sound_speed, 0.0)
+    try:
+        fluid.check_work(radius, length, sound_speed, float(grid[-1]))
+    except ModelError as exc:
+        raise ModelError("--frequencies" if exc.field == "frequency" else _FLAGS[exc.field],
+                         frequencies if exc.field == "frequency" else exc.value, exc.rule) from None
+    nodes = sum(fluid.quadrature_nodes(radius, length, sound_speed, float(f)) for f in grid)
+    limit = MAX_SWEEP_NODES * (LONG_FACTOR if allow_long else 1)
+    if nodes > limit:
+        raise ModelError("--frequencies", frequencies,
+                         f"the sweep would need {describe_count(nodes)} quadrature nodes (limit {describe_count(limit)})"
+                         + ("" if allow_long else "; --allow-long runs it with a progress bar"))
     sweep = _with_flag_names(fluid.frequency_sweep, radius, length, grid, density, sound_speed,
                              progress=_progress)
     if output is not None and output.lower().endswith(".nc"):

@@ -8,7 +8,9 @@ import click
 import numpy as np
 
 from ..errors import ModelError
-from ._common import check_number, console, data_and_figure, draw_and_save, figure_options, fmt, print_json, table
+from ..limits import MAX_LOCUS_STEPS
+from ._common import (at_thrust, check_number, console, data_and_figure, draw_and_save, figure_options, fmt, print_json,
+                      table, user_text)
 
 __all__ = ["commands"]
 
@@ -25,6 +27,23 @@ def _fmt(x: float | None, unit: str = "", digits: int = 6, missing: str = "n/a")
     return fmt(x, unit, digits, missing)
 
 
+def _margin_rows(res, damped: bool | None = None) -> list[tuple[str, str]]:
+    """The rows of the ``critical`` table, the margin saying so when it is below 1 (``check``
+    shows the same rows for its critical thrust and margin)."""
+    from ..display.text import critical_rows
+
+    rows = critical_rows(res, damped)
+    op = res.operating_thrust
+    if res.margin is not None and res.margin < 1.0:
+        note = f"{{}} [red](UNSTABLE at the operating thrust)[/red]"
+    elif res.margin is None and op and res.thrust_max < op:
+        note = (f"> {res.thrust_max / op:.4g}, [yellow]not established[/yellow]: the search ends at "
+                f"{res.thrust_max:g} N, below the operating thrust {op:g} N")
+    else:
+        return rows
+    return [(k, note.format(v) if k.startswith("margin") else v) for k, v in rows]
+
+
 def _vec(v, unit: str) -> str:
     return "[" + ", ".join(fmt(float(x), digits=6) for x in np.asarray(v, dtype=float)) + f"] {unit}"
 
@@ -33,13 +52,14 @@ def _vec(v, unit: str) -> str:
 @click.argument("model_file", type=click.Path(dir_okay=False))
 def check_cmd(model_file: str) -> None:
     """Validate MODEL_FILE and print a summary of the assembled model."""
+    from ..linear.critical_thrust import critical_thrust
     from ..linear.modes import modes
     from ..model.model import DOF_NAMES
 
     model = _load(model_file)
     con = console()
     b = model.body
-    con.print(f"[bold]{model.name}[/bold]  ({model_file}): valid, schema_version 1")
+    con.print(f"[bold]{user_text(model.name)}[/bold]  ({user_text(model_file)}): valid, schema_version 1")
     t = table("assembled model", "item", "value")
     t.add_row("mass", _fmt(b.mass, "kg"))
     t.add_row("cg from A", _vec(b.cg, "m"))
@@ -77,9 +97,15 @@ def check_cmd(model_file: str) -> None:
         t.add_row("added inertia I_a", f"{_fmt(ia)} kg m^2 ({ia / ref.added_inertia:.4f} x strip theory)")
     t.add_row("analysis", f"thrust_max {_fmt(model.analysis.thrust_max, 'N')}, "
               f"linearization {model.analysis.linearization}")
+    crit = critical_thrust(model)
+    rows = dict(_margin_rows(crit, model.is_damped or model.fluid.compressible))
+    t.add_row("critical thrust", rows["critical thrust"] + (f" ({crit.kind})" if crit.thrust is not None else ""))
+    t.add_row("margin (critical / operating)", rows["margin (critical / operating)"])
     con.print(t)
     md = modes(model, 0.0)
     con.print("natural frequencies at zero thrust (Hz): " + ", ".join(_fmt(f, digits=4) for f in md.frequency_hz))
+    for w in crit.warnings:
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
     _static_loads_table(model, con)
 
 
@@ -94,7 +120,7 @@ def _static_loads_table(model, con) -> None:
     try:
         st = static_mount_loads(model)
     except NumericalError as exc:
-        con.print(f"[yellow]warning:[/yellow] static mount loads at the operating thrust: {exc}")
+        con.print(f"[yellow]warning:[/yellow] static mount loads at the operating thrust: {user_text(exc)}")
         return
     t = table(f"static mount deflection and load at the operating thrust {st.thrust:g} N ({st.linearization})",
               ("mount", "right"), ("axial d (mm)", "right"), ("shear d (mm)", "right"), ("|d| (mm)", "right"),
@@ -119,7 +145,7 @@ def _static_loads_table(model, con) -> None:
               "unloaded pose; F: force of the mount on the hull; use: the larger of |F| / rated_force and "
               "|d| / max_deflection (no rating: neither key given)")
     for w in st.warnings:
-        con.print(f"[yellow]warning:[/yellow] {w}")
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
 
 
 @click.command("modes")
@@ -134,17 +160,22 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
     from ..model.model import DOF_NAMES
     from ..response.decoupling import decoupling_check
 
-    check_number("--thrust", thrust, nonneg=True)
+    from ..linear.critical_thrust import critical_thrust
+
+    thrust = check_number("--thrust", thrust, kind="thrust_or_zero")
     model = _load(model_file)
     from ..linear.modes import modes
 
-    res = modes(model, thrust, linearization)
+    res = at_thrust("--thrust", thrust, model, lambda: modes(model, thrust, linearization))
     check = decoupling_check(model, thrust, linearization, modal=res)
+    crit = critical_thrust(model, thrust_max=max(thrust, model.analysis.thrust_max), linearization=linearization)
     if as_json:
-        print_json({**res.to_dict(), "decoupling": check.to_dict()})
+        print_json({**res.to_dict(), "decoupling": check.to_dict(), "stable": res.stable,
+                    "critical_thrust": crit.thrust, "critical_kind": crit.kind,
+                    "warnings": _modes_warnings(res, crit, thrust)})
         return
     scale = float(np.abs(res.eigenvalues).max(initial=0.0))
-    t = table(f"modes of {model.name} at T = {thrust:g} N ({res.linearization} linearization)",
+    t = table(f"modes of {user_text(model.name)} at T = {thrust:g} N ({res.linearization} linearization)",
               ("mode", "right"), ("f (Hz)", "right"), ("omega (rad/s)", "right"), ("zeta (1)", "right"),
               ("growth (1/s)", "right"), "dominant dof")
     for j, dom in enumerate(res.dominant()):
@@ -160,8 +191,12 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
     con.print(e)
     con.print("shares: each dof's part of the mode's kinetic energy in mass-centre coordinates (rows sum to 100); "
               "dominant: the largest share (with any within 1 point of it); zeta = -growth / |lambda| "
-              "(negative: the mode grows); the complex shapes are in --json and --shapes; "
-              + ("stable" if res.stable else "[red]UNSTABLE[/red]"))
+              "(negative: the mode grows); the complex shapes are in --json and --shapes")
+    first = (f"stability is first lost at {crit.thrust:.8g} N ({crit.kind})" if crit.thrust is not None
+             else f"stable from 0 to {crit.thrust_max:g} N")
+    con.print(("stable" if res.stable else "[red]UNSTABLE[/red]") + f" at {thrust:g} N; {first}")
+    for w in _modes_warnings(res, crit, thrust):
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
     if shapes:
         st = table("mode shapes at A: displacement (m) and rotation (rad), largest component 1", ("mode", "right"),
                    *((f"|{n}|", "right") for n in DOF_NAMES))
@@ -187,13 +222,18 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
     from ..io import atomic_path
     from ..linear.locus import locus
 
-    check_number("--thrust-max", thrust_max, positive=True)
-    if steps < 1 or steps > 100000:
-        raise ModelError("--steps", steps, "must be between 1 and 100000")
+    thrust_max = check_number("--thrust-max", thrust_max, kind="thrust")
+    if steps < 1 or steps > MAX_LOCUS_STEPS:
+        raise ModelError("--steps", steps, f"must be between 1 and {MAX_LOCUS_STEPS}")
     out = Path(output) if output else Path(Path(model_file).stem + "-locus.nc")
     data, fig_path = data_and_figure(out, (".nc",), figure, no_plot, dpi)
     model = _load(model_file)
-    res = locus(model, steps=steps, thrust_max=thrust_max, linearization=linearization, critical=True)
+    try:
+        res = locus(model, steps=steps, thrust_max=thrust_max, linearization=linearization, critical=True)
+    except ModelError as exc:
+        if exc.field != "thrust_max":
+            raise
+        raise ModelError("--thrust-max" if thrust_max is not None else "analysis.thrust_max", exc.value, exc.rule) from None
     if data is not None:
         with atomic_path(data) as tmp:
             res.to_xarray().to_netcdf(tmp, engine="h5netcdf")
@@ -204,7 +244,7 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
         con.print(f"critical thrust: none up to {res.thrust[-1]:g} N (stable over the whole range)")
     else:
         con.print(f"critical thrust: {_fmt(res.critical_thrust, 'N')} ({res.critical_kind})")
-    con.print("wrote " + " and ".join(str(p) for p in (data, fig_path) if p is not None))
+    con.print("wrote " + " and ".join(user_text(p) for p in (data, fig_path) if p is not None))
 
 
 @click.command("critical")
@@ -215,17 +255,16 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
 @click.option("--all-crossings", is_flag=True, help="also list later losses and gains of stability")
 def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linearization: str | None, all_crossings: bool) -> None:
     """Critical thrust, kind, frequency and margin."""
-    from ..display.text import critical_rows
     from ..linear.critical_thrust import critical_thrust
 
-    check_number("--thrust-max", thrust_max, positive=True)
+    thrust_max = check_number("--thrust-max", thrust_max, kind="thrust")
     model = _load(model_file)
     res = critical_thrust(model, thrust_max=thrust_max, linearization=linearization, all_crossings=all_crossings)
     if as_json:
         print_json(res.to_dict())
         return
-    t = table(f"critical thrust of {model.name}", "quantity", "value")
-    for name, value in critical_rows(res, model.is_damped or model.fluid.compressible):
+    t = table(f"critical thrust of {user_text(model.name)}", "quantity", "value")
+    for name, value in _margin_rows(res, model.is_damped or model.fluid.compressible):
         t.add_row(name, value)
     for c in res.crossings:
         t.add_row(f"crossing ({c.direction})", f"{c.load:.10g} N, {c.kind}, {fmt(c.omega / (2 * np.pi))} Hz")
@@ -235,7 +274,16 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
     con = console()
     con.print(t)
     for w in res.warnings:
-        con.print(f"[yellow]warning:[/yellow] {w}")
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
+
+
+def _modes_warnings(res, crit, thrust: float) -> list[str]:
+    """What ``modes`` must say when its eigenvalues and the critical-thrust search disagree."""
+    out = []
+    if not res.stable and (crit.thrust is None or thrust < crit.thrust * (1 - 1e-6)):
+        out.append(f"an eigenvalue grows at {thrust:g} N although the critical-thrust search finds the model "
+                   + (f"stable below {crit.thrust:.8g} N" if crit.thrust is not None else f"stable up to {crit.thrust_max:g} N"))
+    return out
 
 
 commands = [check_cmd, modes_cmd, locus_cmd, critical_cmd]

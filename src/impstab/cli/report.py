@@ -77,7 +77,10 @@ def report_cmd(ctx: click.Context, model_or_store: str, output: str | None, sect
     if matplotlib.get_backend().lower() != "agg":
         matplotlib.use("Agg", force=True)
     out = check_report_path(output) if output is not None else _default_output(model_or_store)
-    check_number("--duration", duration, positive=True)
+    check_number("--duration", duration, kind="duration")
+    from ._common import check_output
+
+    check_output("--output", out)
     check_number("--target-margin", target_margin, positive=True)
     chosen = None
     if sections is not None:
@@ -98,9 +101,9 @@ def report_cmd(ctx: click.Context, model_or_store: str, output: str | None, sect
                + ", ".join(f"{len(v)} {k}" for k, v in states.items()) + f"), {rep.figures} figures, {rep.tables} tables")
     for s in rep.sections:
         if s.status == "not computed":
-            click.echo(f"{s.name}: not computed: {s.reason}")
+            click.echo(f"{s.name}: not computed: {printable(s.reason)}")
         elif s.status == "failed":
-            click.echo(f"impstab: warning: section {s.name} failed: {s.reason}", err=True)
+            click.echo(f"impstab: warning: section {s.name} failed: {printable(s.reason)}", err=True)
 
 
 commands = [report_cmd]

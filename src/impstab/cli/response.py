@@ -8,7 +8,7 @@ import click
 import numpy as np
 
 from ..errors import ModelError
-from ._common import check_number, console, print_json
+from ._common import at_thrust, check_number, check_output, console, print_json, user_text
 
 __all__ = ["commands"]
 
@@ -28,7 +28,7 @@ def _frequencies(spec: str) -> np.ndarray:
             num = 0
         if num > MAX_FREQUENCIES:
             raise ModelError("--frequencies", spec, f"NUM must be at most {MAX_FREQUENCIES}")
-    return parse_frequencies(spec)
+    return parse_frequencies(spec, MAX_FREQUENCIES)
 
 
 def _summary(res, model_name: str) -> None:
@@ -36,7 +36,7 @@ def _summary(res, model_name: str) -> None:
 
     con = console()
     kind = "moment" if res.input_unit == "N m" else "force"
-    t = Table(title=f"forced response of {model_name} at T = {res.thrust:g} N ({res.linearization}), unit {res.input} {kind} at A")
+    t = Table(title=f"forced response of {user_text(model_name)} at T = {res.thrust:g} N ({res.linearization}), unit {res.input} {kind} at A")
     t.add_column("quantity")
     t.add_column("value")
     f, tr = res.frequency_hz, res.transmissibility
@@ -57,7 +57,7 @@ def _summary(res, model_name: str) -> None:
     t.add_row("fluid", str(res.settings.get("fluid", "")))
     con.print(t)
     for w in res.warnings:
-        con.print(f"[yellow]warning:[/yellow] {w}")
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
 
 
 def _excitation_tables(ex) -> None:
@@ -70,7 +70,7 @@ def _excitation_tables(ex) -> None:
     mag = ex.hull_force_magnitude
     for i, src in enumerate(ex.source):
         level = 20 * np.log10(mag[i] / np.sqrt(2)) if mag[i] > 0 else -np.inf
-        t.add_row(src, f"{ex.frequency_hz[i]:.5g}", f"{mag[i]:.5g}", f"{level:.2f}", f"{ex.power_transmitted[i].sum():.4g}")
+        t.add_row(user_text(src), f"{ex.frequency_hz[i]:.5g}", f"{mag[i]:.5g}", f"{level:.2f}", f"{ex.power_transmitted[i].sum():.4g}")
     con.print(t)
     b = ex.bands()
     if b.index.size:
@@ -83,7 +83,7 @@ def _excitation_tables(ex) -> None:
                        f"{lvl:.2f}" if np.isfinite(lvl) else "-")
         con.print(bt)
     for w in ex.warnings:
-        con.print(f"[yellow]warning:[/yellow] {w}")
+        con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
 
 
 def _write(out: Path, res, ex, plot: bool) -> list[Path]:
@@ -137,14 +137,19 @@ def response_cmd(model_file: str, spec: str, thrust: float | None, dof: str | No
     from ..response import excitation_response, frequency_response
 
     freqs = _frequencies(spec)
-    check_number("--thrust", thrust, nonneg=True)
+    thrust = check_number("--thrust", thrust, kind="thrust_or_zero")
     if dof is not None and dof not in DOF_NAMES:
         raise ModelError("--input", dof, f"must be one of {list(DOF_NAMES)}")
     out = Path(output) if output else None
     if out is not None and out.suffix.lower() not in (".nc", ".png"):
         raise ModelError("--output", output, "must end in .nc (netCDF; a PNG is written beside it) or .png")
+    if out is not None:
+        check_output("--output", out)
+        check_output("--output", out.with_suffix(".png"))
     model = load_model(model_file)
-    res = frequency_response(model, freqs, thrust=thrust, input=dof, linearization=linearization)
+    t_lin = thrust if thrust is not None else (model.thrust.operating or 0.0)
+    res = at_thrust("--thrust", t_lin, model,
+                    lambda: frequency_response(model, freqs, thrust=thrust, input=dof, linearization=linearization))
     ex = excitation_response(model, thrust=thrust, linearization=linearization) if excitation else None
     written = _write(out, res, ex, plot=not (no_plot and out.suffix.lower() == ".nc")) if out is not None else []
     if as_json:
@@ -157,7 +162,7 @@ def response_cmd(model_file: str, spec: str, thrust: float | None, dof: str | No
     if ex is not None:
         _excitation_tables(ex)
     if written:
-        console().print("wrote " + " and ".join(map(str, written)))
+        console().print("wrote " + " and ".join(map(user_text, written)))
 
 
 commands = [response_cmd]

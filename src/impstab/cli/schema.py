@@ -29,11 +29,14 @@ def schema_cmd(study: bool, markdown: bool, output: str | None) -> None:
     if output is None:
         click.echo(text, nl=False)
         return
+    from ..errors import printable
     from ..io import atomic_path
+    from ._common import check_output
 
+    check_output("--output", output)
     with atomic_path(output) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")
-    click.echo(f"wrote {output}", err=True)
+    click.echo(f"wrote {printable(output)}", err=True)
 
 
 commands = [schema_cmd]

@@ -9,9 +9,11 @@ from pathlib import Path
 
 import click
 
-from ..errors import ModelError
 from ..display.format import growth
-from ._common import check_number, console, data_and_figure, draw_and_save, figure_options, fmt, print_json, table
+from ..errors import ModelError, printable
+from ..limits import LONG_FACTOR, MAX_OUTPUT_BYTES, MAX_STEPS, MAX_THRUSTS, describe_count
+from ._common import (at_thrust, check_number, console, data_and_figure, draw_and_save, figure_options, fmt, print_json,
+                      table, user_text)
 
 __all__ = ["commands"]
 
@@ -29,13 +31,12 @@ def _thrust_list(thrust: float | None, thrusts: str | None) -> list[float]:
                              "must be numbers separated by commas, e.g. 10000,18012,20000") from None
         if not values:
             raise ModelError("--thrusts", thrusts, "must list at least one thrust")
-        for v in values:
-            check_number("--thrusts", v, nonneg=True)
-        return values
+        if len(values) > MAX_THRUSTS:
+            raise ModelError("--thrusts", f"{len(values)} thrusts", f"must list at most {MAX_THRUSTS} thrusts")
+        return [check_number("--thrusts", v, kind="thrust_or_zero") for v in values]
     if thrust is None:
         raise ModelError("--thrust", None, "give the thrust in N (--thrust T) or several (--thrusts T1,T2,T3)")
-    check_number("--thrust", thrust, nonneg=True)
-    return [thrust]
+    return [check_number("--thrust", thrust, kind="thrust_or_zero")]
 
 
 def _dof_values(option: str, items: tuple[str, ...]) -> dict[str, float]:
@@ -51,9 +52,35 @@ def _dof_values(option: str, items: tuple[str, ...]) -> dict[str, float]:
             v = float(value)
         except ValueError:
             raise ModelError(option, item, "must be DOF=VALUE with a number VALUE") from None
-        check_number(option, v)
-        out[name] = v
+        out[name] = check_number(option, v, kind="displacement" if option == "--displace" else "velocity")
     return out
+
+
+def _check_work(model, step_sizes: list[float], duration: float, dt: float | None, sample: float | None,
+                allow_long: bool) -> None:
+    """Refuse a simulation whose time steps or stored samples exceed the limits, before it runs.
+
+    ``step_sizes`` holds each run's step (s). The samples of a run are every step, at most
+    :data:`~impstab.dynamics.simulate.MAX_SAMPLES` of them, unless ``--sample`` is given; each
+    takes 8 bytes for the time, the 12 states, the thrust, the error estimate and the 6 loads of
+    every mount, twice (the run and the file written from it).
+    """
+    from ..dynamics.simulate import MAX_SAMPLES
+
+    limit = MAX_STEPS * (LONG_FACTOR if allow_long else 1)
+    total = sum(duration / h for h in step_sizes)
+    option = "--dt" if dt is not None else "--duration"
+    if total > limit:
+        hint = "" if allow_long else f"; --allow-long runs up to {describe_count(limit * LONG_FACTOR)} with a progress bar"
+        raise ModelError(option, dt if dt is not None else duration,
+                         f"would need {describe_count(total)} time steps (limit {describe_count(limit)}){hint}")
+    per_sample = 8 * 2 * (15 + 6 * len(model.mounts))
+    samples = sum(math.ceil(duration / sample) if sample is not None else min(math.ceil(duration / h), MAX_SAMPLES)
+                  for h in step_sizes)
+    if samples * per_sample > MAX_OUTPUT_BYTES:
+        raise ModelError("--sample" if sample is not None else option, sample if sample is not None else duration,
+                         f"{describe_count(samples)} stored samples would take {samples * per_sample / 1024**3:.3g} GiB "
+                         f"(limit {MAX_OUTPUT_BYTES / 1024**3:g} GiB): use a longer --sample interval")
 
 
 def _progress(enabled: bool):
@@ -83,7 +110,7 @@ def _write(results, out: Path) -> None:
 
 
 def _table(results, model_name: str):
-    t = table(f"time simulation of {model_name}", ("thrust (N)", "right"), "class", "envelope",
+    t = table(f"time simulation of {user_text(model_name)}", ("thrust (N)", "right"), "class", "envelope",
               ("fitted\ngrowth (1/s)", "right"), ("max Re λ\n(1/s)", "right"), ("diff.", "right"), "status")
     for r in results:
         g = r.growth
@@ -103,7 +130,7 @@ def _notes(results) -> list[str]:
     lines = ["fitted growth, and its difference from max Re λ: for exponential envelopes only (n/a otherwise)"]
     steps = ", ".join(str(r.steps) if r.steps >= 0 else f"{r.rhs_evaluations} f-evals" for r in results)
     lines.append(f"steps: {steps}; run time: {', '.join(fmt(r.wall_time, digits=3) for r in results)} s")
-    lines += [f"T = {r.thrust[0]:.6g} N: {r.stop_reason}" for r in results if not r.completed]
+    lines += [f"T = {r.thrust[0]:.6g} N: {user_text(r.stop_reason)}" for r in results if not r.completed]
     return lines
 
 
@@ -124,8 +151,11 @@ def _notes(results) -> list[str]:
                    "or a figure only (.png, .svg, .pdf)")
 @figure_options
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object (settings and outcome of each run)")
+@click.option("--allow-long", is_flag=True,
+              help=f"run beyond the limit of {MAX_STEPS:.0e} time steps (up to {LONG_FACTOR} times more), "
+                   "with a progress bar on a terminal")
 def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, tol, displace, kick, output,
-                 figure, dpi, no_plot, as_json) -> None:
+                 figure, dpi, no_plot, as_json, allow_long) -> None:
     """Nonlinear time histories of MODEL_FILE from the static equilibrium under thrust.
 
     Writes the time histories (netCDF or CSV) and a PNG of sway and pitch like the paper's
@@ -137,10 +167,10 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     from ..model import load_model
 
     values = _thrust_list(thrust, thrusts)
-    check_number("--duration", duration, positive=True)
-    check_number("--dt", dt, positive=True)
-    check_number("--sample", sample, positive=True)
-    check_number("--tol", tol, positive=True)
+    duration = check_number("--duration", duration, kind="duration")
+    dt = check_number("--dt", dt, kind="time_step")
+    sample = check_number("--sample", sample, kind="time_step")
+    tol = check_number("--tol", tol, kind="tolerance")
     out = Path(output) if output else Path(Path(model_file).stem + "-simulation.nc")
     data, fig_path = data_and_figure(out, (".nc", ".csv"), figure, no_plot, dpi)
     pert = None
@@ -148,10 +178,13 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
         pert = {"displacement": _dof_values("--displace", displace), "velocity": _dof_values("--kick", kick)}
     model = load_model(model_file)
     crit = critical_thrust(model, linearization="equilibrium").thrust
+    steps = {v: at_thrust("--thrusts" if thrusts else "--thrust", v, model, lambda v=v: default_step(model, v))
+             for v in values}
     if len(values) > 1 and dt is None:  # one time grid for all runs
-        dt = min(default_step(model, v) for v in values)
+        dt = min(steps.values())
     if len(values) > 1 and sample is None:
         sample = dt * max(1, math.ceil(duration / dt / 100_000))
+    _check_work(model, [dt or steps[v] for v in values], duration, dt, sample, allow_long)
     results = []
     with _progress(sys.stderr.isatty() and not as_json) as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -160,8 +193,8 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
             results.append(simulate(model, thrust=v, duration=duration, integrator=integrator.lower(), dt=dt,
                                     perturbation=pert, sample=sample, tol=tol, critical_thrust=crit,
                                     progress=lambda f, task=task: bar.update(task, completed=f)))
-    for w in {str(w.message) for w in caught}:
-        click.echo(f"impstab: warning: {w}", err=True)
+    for w in dict.fromkeys(str(w.message) for w in caught):
+        click.echo(f"impstab: warning: {printable(w)}", err=True)
     if data is not None:
         _write(results, data)
     if fig_path is not None:
@@ -176,7 +209,7 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
         con.print(line)
     con.print(f"critical thrust {crit:.8g} N" if crit is not None
               else f"no critical thrust up to thrust_max = {model.analysis.thrust_max:g} N")
-    con.print("wrote " + " and ".join(str(p) for p in (data, fig_path) if p is not None))
+    con.print("wrote " + " and ".join(user_text(p) for p in (data, fig_path) if p is not None))
 
 
 commands = [simulate_cmd]

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import click
 
-from ..errors import ModelError
-from ._common import check_number, console, draw_and_save, print_json, table
+from ..errors import ModelError, printable
+from ._common import check_number, check_output, console, draw_and_save, print_json, table, user_text
 
 __all__ = ["commands"]
 
@@ -76,8 +76,10 @@ def stats_cmd(store: str, target_margin: float | None, confidence: float, no_sen
 
     check_number("--target-margin", target_margin, positive=True)
     check_number("--confidence", confidence, positive=True)
-    check_number("--dpi", dpi, positive=True)
+    check_number("--dpi", dpi, kind="dpi")
     out = check_figure_path(output) if output else None
+    if out is not None:
+        check_output("--output", out)
     res = open_study(store)
     kw = {"confidence": confidence, "sensitivity": not no_sensitivity}
     try:
@@ -100,9 +102,9 @@ def stats_cmd(store: str, target_margin: float | None, confidence: float, no_sen
         con.print(_sensitivity_table(stats.sensitivity))
     con.print()
     for note in stats.notes:
-        click.echo(textwrap.fill(f"note: {note}", width=80, subsequent_indent="  "))
+        click.echo(textwrap.fill(f"note: {printable(note)}", width=80, subsequent_indent="  "))
     if out is not None:
-        con.print(f"wrote {out}")
+        con.print(f"wrote {user_text(out)}")
 
 
 commands = [stats_cmd]

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import click
 
-from ..errors import ModelError
-from ._common import check_number, console, draw_and_save, fmt, table
+from ..errors import ModelError, printable
+from ._common import check_number, check_output, console, draw_and_save, fmt, table, user_text
 
 __all__ = ["commands"]
 
@@ -44,11 +44,12 @@ def sweep_cmd(study_file: str, store: str | None, workers: int | None, scheduler
 
     if workers is not None and scheduler is not None:
         raise ModelError("--workers", workers, "give either --workers or --scheduler, not both")
-    if workers is not None and workers < 1:
-        raise ModelError("--workers", workers, "must be >= 1")
+    if workers is not None and not 1 <= workers <= _max_workers():
+        raise ModelError("--workers", workers, f"must be between 1 and {_max_workers()} (4 per CPU core of this machine)")
     for path in exports:
         if Path(path).suffix.lower() not in _EXPORTS:
             raise ModelError("--export", path, "must end in .nc (netCDF) or .csv")
+        check_output("--export", path)
     study = load_study(study_file)
     out = Path(store) if store else Path(Path(study_file).stem + ".zarr")
     if progress is None:
@@ -68,29 +69,36 @@ def _summary(res, study, out: Path, elapsed: float, written: list[str]) -> None:
     from ..model.reference import label, unit
 
     counts = res.counts()
-    t = table(f"design study {study.name}: {study.size} designs ({study.method})", "quantity", "value")
-    t.add_row("parameters", "; ".join(f"{p.name}: {label(p.name)}" for p in study.parameters))
+    t = table(f"design study {user_text(study.name)}: {study.size} designs ({study.method})", "quantity", "value")
+    t.add_row("parameters", user_text("; ".join(f"{p.name}: {label(p.name)}" for p in study.parameters)))
     t.add_row("designs", ", ".join(f"{k} {v}" for k, v in counts.items() if v or k == "ok"))
     t.add_row("time (this run)", f"{elapsed:.3g} s")
     if counts["ok"]:
         for by, u in (("margin", ""), ("critical_thrust", "N")):
             if by in res.dataset:
                 best = res.best(by)
-                where = ", ".join(f"{k} = {_fmt(v, unit(k) if unit(k) not in (None, '1') else '')}"
-                                  for k, v in best["parameters"].items())
+                where = user_text(", ".join(f"{k} = {_fmt(v, unit(k) if unit(k) not in (None, '1') else '')}"
+                                            for k, v in best["parameters"].items()))
                 text = _fmt(best["value"], u)
                 if best["lower_bound"]:
                     text = f">= {text}: {best['warning']},"
                 t.add_row(f"largest {by}", f"{text} at {where}")
                 break
-    t.add_row("store", str(out))
+    t.add_row("store", user_text(out))
     for w in written:
-        t.add_row("exported", w)
+        t.add_row("exported", user_text(w))
     console().print(t)
     failed = res.dataset["status"].values > 0
     if failed.any():
         first = res.dataset["message"].values[failed][0]
-        click.echo(f"impstab: {int(failed.sum())} designs failed (see 'status' and 'message'); first: {first}", err=True)
+        click.echo(f"impstab: {int(failed.sum())} designs failed (see 'status' and 'message'); first: {printable(first)}",
+                   err=True)
+
+
+def _max_workers() -> int:
+    import os
+
+    return 4 * (os.cpu_count() or 1)
 
 
 def _parse_at(items: tuple[str, ...]) -> dict[str, object]:
@@ -123,10 +131,11 @@ def map_cmd(store: str, x: str | None, y: str | None, value: str, at: tuple[str,
 
     out = Path(output) if output else Path(str(Path(store)).rstrip("/\\").removesuffix(".zarr") + "-map.png")
     check_figure_path(out)
-    check_number("--dpi", dpi, positive=True)
+    check_output("--output", out)
+    check_number("--dpi", dpi, kind="dpi")
     res = open_study(store)
     draw_and_save(lambda: res.plot(x=x, y=y, value=value, at=_parse_at(at)), out, dpi)
-    console().print(f"wrote {out}")
+    console().print(f"wrote {user_text(out)}")
 
 
 commands = [sweep_cmd, map_cmd]

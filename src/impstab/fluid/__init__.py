@@ -13,7 +13,7 @@ See ``docs/fluid.md`` for the formulas, the numerics and the validation.
 
 from __future__ import annotations
 
-from .baffled_cylinder import baffled_cylinder
+from .baffled_cylinder import baffled_cylinder, check_work, quadrature_nodes
 from .impedance import incompressible_kernel, modal_impedance
 from .result import FluidCoefficients
 from .strip import strip_theory
@@ -21,5 +21,5 @@ from .sweep import FrequencySweep, frequency_sweep
 
 __all__ = [
     "baffled_cylinder", "strip_theory", "FluidCoefficients", "frequency_sweep", "FrequencySweep",
-    "modal_impedance", "incompressible_kernel",
+    "modal_impedance", "incompressible_kernel", "quadrature_nodes", "check_work",
 ]

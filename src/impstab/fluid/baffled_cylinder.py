@@ -20,10 +20,12 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
-from .integrals import window_integrals
+from ..errors import ModelError
+from ..limits import MAX_QUADRATURE_NODES
+from .integrals import estimate_nodes, window_integrals
 from .result import FluidCoefficients, check_nonnegative, check_optional_positive, check_positive
 
-__all__ = ["baffled_cylinder", "TARGET_ERROR"]
+__all__ = ["baffled_cylinder", "TARGET_ERROR", "quadrature_nodes", "check_work"]
 
 TARGET_ERROR = 1e-9  # the panel layout is refined until the (conservative) estimate is below
 _MAX_REFINE = 4
@@ -71,12 +73,44 @@ def baffled_cylinder(
     >>> round(r.strip_ratio, 4)
     0.8142
     """
-    a = check_positive("radius", radius)
-    L = check_positive("length", length)
-    rho = check_positive("density", density)
-    c = check_optional_positive("sound_speed", sound_speed)
-    f = check_nonnegative("frequency", frequency)
+    a = check_positive("radius", radius, "size")
+    L = check_positive("length", length, "size")
+    rho = check_positive("density", density, "density")
+    c = check_optional_positive("sound_speed", sound_speed, "sound_speed")
+    f = check_nonnegative("frequency", frequency, "frequency")
+    check_work(a, L, c, f)
     return _baffled_cylinder(a, L, rho, c, f)
+
+
+def quadrature_nodes(radius: float, length: float, sound_speed: float | None, frequency: float) -> int:
+    """Impedance evaluations of :func:`baffled_cylinder` on its production panel layout.
+
+    An upper estimate computed from the layout rules without building it (the panels grow with
+    ``L / a`` and with the number of wavelengths ``k0 L / 2 pi`` along the segment); the error
+    control may refine the layout up to 4 times (:data:`_MAX_REFINE`).
+    """
+    s0 = 0.0 if sound_speed is None else 2.0 * math.pi * frequency * radius / sound_speed
+    return estimate_nodes(0.5 * length / radius, s0)
+
+
+def check_work(radius: float, length: float, sound_speed: float | None, frequency: float) -> None:
+    """ModelError (naming ``length`` or ``frequency``) when the quadrature would need more than
+    :data:`impstab.limits.MAX_QUADRATURE_NODES` nodes."""
+    nodes = quadrature_nodes(radius, length, sound_speed, frequency)
+    if nodes <= MAX_QUADRATURE_NODES:
+        return
+    if sound_speed is not None and frequency > 0 and 2.0 * math.pi * frequency * radius / sound_speed > 1.5:
+        waves = frequency * length / sound_speed
+        raise ModelError(
+            "frequency", frequency,
+            f"the segment is {waves:.3g} wavelengths long at this frequency: the quadrature would need "
+            f"{nodes:.3g} nodes (limit {MAX_QUADRATURE_NODES:.0e}); lower the frequency or the length",
+        )
+    raise ModelError(
+        "length", length,
+        f"a segment {length / radius:.3g} radii long would need {nodes:.3g} quadrature nodes "
+        f"(limit {MAX_QUADRATURE_NODES:.0e}); for so slender a segment strip theory is within 1.2 a / L of the baffled value",
+    )
 
 
 @lru_cache(maxsize=4096)

@@ -31,7 +31,7 @@ from .impedance import evanescent_ratio, radiating_ratio
 from .quadrature import PanelRule, graded_edges, growing_edges, split_long
 from .windows import ORDERS, window_parts, window_squared
 
-__all__ = ["WindowIntegrals", "window_integrals"]
+__all__ = ["WindowIntegrals", "window_integrals", "estimate_nodes"]
 
 GRADING_RATIO = 0.3     # panel [r h, h] sees the singularity at 0.43 of its length
 GRADING_DEPTH = 1e-8    # innermost panel, relative to min(graded extent, 1)
@@ -129,6 +129,30 @@ def _tail(ell: float, s0: float, upper: float, refine: int):
         sums[i, 0] += (phase * total).real
         sums[i, 1] += 2.0 * np.hypot(err_re, err_im)
     return sums, count + t.size
+
+
+def estimate_nodes(ell: float, s0: float, refine: int = 1) -> int:
+    """Upper estimate of the impedance evaluations of :func:`window_integrals`, in O(1).
+
+    Counts the panels of the layout from its rules instead of building it (whose size grows
+    like ``(s0 + 1.5) ell / pi``, the number of half periods of the window on the real axis),
+    so that a layout too large for memory is refused before any of it exists.
+    """
+    nodes_per_panel = 21 * refine
+    upper = max(s0 + LINE_OFFSET, X_MIN / ell)
+    width = np.pi / ell
+    extents = [s0, upper - s0] if s0 > 0.0 else [upper]
+    panels = 0.0
+    for extent in extents:
+        smallest = GRADING_DEPTH**refine * min(extent, 1.0)
+        levels = max(0.0, np.ceil(np.log(smallest / extent) / np.log(GRADING_RATIO)))
+        panels += levels + 2.0 + extent / width
+    dist = upper - s0
+    panels += max(0.0, np.ceil(np.log2(max(s0, dist) / dist))) + len(_U_EDGES) - 1
+    cap, end = 3.0 / ell, DECAY / (2.0 * ell)
+    panels += max(0.0, np.log2(cap / dist)) + 3.0 + end / cap
+    total = nodes_per_panel * panels
+    return int(min(total, 2.0**62))
 
 
 def window_integrals(ell: float, s0: float, refine: int = 1) -> WindowIntegrals:

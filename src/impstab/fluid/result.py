@@ -6,44 +6,28 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from ..errors import ModelError
+from ..limits import check_number
 
 __all__ = ["FluidCoefficients", "check_positive", "check_nonnegative", "check_optional_positive"]
 
 
-def _as_float(name: str, value: object) -> float:
-    if isinstance(value, bool):
-        raise ModelError(name, value, "must be a number")
-    try:
-        return float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ModelError(name, value, "must be a number") from None
+def check_positive(name: str, value: object, kind: str = "positive") -> float:
+    """``value`` as a float in ``impstab.limits.RANGES[kind]`` (``"size"``, ``"density"``, ...),
+    or :class:`~impstab.errors.ModelError` naming ``name``."""
+    return check_number(name, value, kind)
 
 
-def check_positive(name: str, value: object) -> float:
-    """``value`` as a float, or :class:`~impstab.errors.ModelError` unless finite and > 0."""
-    x = _as_float(name, value)
-    if not (math.isfinite(x) and x > 0.0):
-        raise ModelError(name, value, "must be a finite number > 0")
-    return x
+def check_nonnegative(name: str, value: object, kind: str = "frequency") -> float:
+    """``value`` as a float >= 0 in ``RANGES[kind]`` (``-0.0`` becomes ``0.0``)."""
+    return check_number(name, value, kind) + 0.0
 
 
-def check_nonnegative(name: str, value: object) -> float:
-    """``value`` as a float, or :class:`~impstab.errors.ModelError` unless finite and >= 0."""
-    x = _as_float(name, value)
-    if not (math.isfinite(x) and x >= 0.0):
-        raise ModelError(name, value, "must be a finite number >= 0")
-    return x + 0.0  # -0.0 -> 0.0
-
-
-def check_optional_positive(name: str, value: object) -> float | None:
-    """None, or ``value`` as a float checked by :func:`check_positive`."""
+def check_optional_positive(name: str, value: object, kind: str = "sound_speed") -> float | None:
+    """None, or ``value`` checked by :func:`check_positive` (omit a sound speed for an
+    incompressible fluid)."""
     if value is None:
         return None
-    x = _as_float(name, value)
-    if not (math.isfinite(x) and x > 0.0):
-        raise ModelError(name, value, "must be a finite number > 0 (omit it for an incompressible fluid)")
-    return x
+    return check_number(name, value, kind)
 
 
 @dataclass(frozen=True)

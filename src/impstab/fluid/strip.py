@@ -33,9 +33,9 @@ def strip_theory(radius: float, length: float, density: float = 1025.0) -> Fluid
         ``added_mass = rho pi a^2 L`` (kg), ``added_inertia = rho pi a^2 L^3 / 12`` (kg m^2),
         no radiation resistance (None), frequency 0, ``error_estimate`` 0.
     """
-    a = check_positive("radius", radius)
-    L = check_positive("length", length)
-    rho = check_positive("density", density)
+    a = check_positive("radius", radius, "size")
+    L = check_positive("length", length, "size")
+    rho = check_positive("density", density, "density")
     mass = rho * math.pi * a * a * L
     return FluidCoefficients(
         model="strip",

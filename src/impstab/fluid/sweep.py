@@ -138,7 +138,7 @@ def frequency_sweep(
 
     ``progress``, if given, wraps the list of frequencies (e.g. a progress bar).
     """
-    values = [check_nonnegative("frequencies", f) for f in frequencies]
+    values = [check_nonnegative("frequencies", f, "frequency") for f in frequencies]
     if not values:
         raise ModelError("frequencies", [], "must hold at least one frequency")
     iterator = progress(values) if progress is not None else values

@@ -8,11 +8,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from ..limits import check_number
 from ..model.model import DOF_NAMES, Model
 from .critical import CriticalLoad, Crossing, critical_load_family
 from .linearize import ModelFamily
 
-__all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD"]
+__all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD", "operating_point_warnings"]
 
 #: share of kinetic energy above which a dof is listed among the modes involved
 PARTICIPATION_THRESHOLD = 0.05
@@ -127,6 +128,20 @@ class CriticalThrust:
         return json.dumps(jsonable(self.to_dict()))
 
 
+def operating_point_warnings(critical: float | None, operating: float | None, thrust_max: float) -> tuple[str, ...]:
+    """What a critical-thrust result must say about the operating point: that the model is
+    unstable there, or that the search did not reach it."""
+    if operating is None:
+        return ()
+    if critical is not None and critical < operating:
+        return (f"the model is unstable at its operating thrust {operating:g} N: stability is lost at "
+                f"{critical:.6g} N (margin {critical / operating:.4g})",)
+    if critical is None and thrust_max < operating:
+        return (f"the search ends at {thrust_max:g} N, below the operating thrust {operating:g} N: "
+                "stability at the operating point is not established",)
+    return ()
+
+
 def _modes(part: NDArray[np.float64] | None) -> tuple[str, ...]:
     if part is None:
         return ()
@@ -159,7 +174,7 @@ def critical_thrust(
     -------
     CriticalThrust
     """
-    t_max = float(thrust_max if thrust_max is not None else model.analysis.thrust_max)
+    t_max = check_number("thrust_max", thrust_max if thrust_max is not None else model.analysis.thrust_max, "thrust")
     search = dict(n_scan=n_scan)
     f_fluid, iterations, change = 0.0, 0, None
     fam = ModelFamily(model, linearization)
@@ -182,6 +197,7 @@ def critical_thrust(
         )
     else:
         und = res
+    notes = operating_point_warnings(res.load, model.thrust.operating, t_max)
     return CriticalThrust(
         thrust=res.load,
         kind=res.kind,
@@ -200,5 +216,5 @@ def critical_thrust(
         fluid_frequency_hz=f_fluid if model.fluid.compressible else None,
         fluid_iterations=iterations,
         fluid_change=change,
-        warnings=tuple(res.warnings) + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
+        warnings=notes + tuple(res.warnings) + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
     )

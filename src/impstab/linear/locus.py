@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ModelError
+from ..limits import check_number
 from ..model.model import DOF_NAMES, Model
 from .eigen import state_matrices
 from .linearize import ModelFamily
@@ -242,9 +243,7 @@ def locus(
     if thrusts is None:
         if steps < 1:
             raise ModelError("steps", steps, "must be at least 1")
-        t_max = float(thrust_max if thrust_max is not None else model.analysis.thrust_max)
-        if not (np.isfinite(t_max) and t_max > 0):
-            raise ModelError("thrust_max", t_max, "must be a finite number > 0")
+        t_max = check_number("thrust_max", thrust_max if thrust_max is not None else model.analysis.thrust_max, "thrust")
         thrusts = np.linspace(0.0, t_max, steps + 1)
     thrusts = np.asarray(thrusts, dtype=float)
     if thrusts.ndim != 1 or thrusts.size == 0 or not np.all(np.isfinite(thrusts)):

@@ -6,6 +6,7 @@ Every failure is a :class:`~impstab.errors.ModelError` naming the field, the val
 from __future__ import annotations
 
 import os
+import stat
 import tomllib
 from dataclasses import replace
 from pathlib import Path
@@ -15,17 +16,18 @@ import numpy as np
 from pydantic import ValidationError
 
 from ..errors import ModelError
+from ..limits import MAX_FILE_BYTES, MAX_LIST_ITEMS, MAX_MOUNTS, MAX_NESTING, MIN_DIRECTION, RANGES
 from .body import RigidBody
 from .isolation_specs import excitation_from_spec, foundation_from_spec
 from .fluid import FluidLoading, Hull
 from .model import AnalysisSettings, Model
 from .mounts import Mount, axial_shear_matrix, elastic_stiffness, ring_positions
 from .reference import DOC_PATH
-from .schema import ModelFile
+from .schema import UNION_TAGS, ModelFile, mark_at
 from .schema_doc import clean_loc, unknown_key_rule
 from .thrust import Propeller, Thrust
 
-__all__ = ["load_model", "model_from_dict", "format_location", "unit_vector"]
+__all__ = ["load_model", "model_from_dict", "format_location", "unit_vector", "read_toml", "read_text", "check_nesting"]
 
 _SYM_TOL = 1e-9
 
@@ -51,11 +53,44 @@ def _lookup(data: Any, loc: tuple) -> Any:
     return cur
 
 
+def _plain_loc(loc: tuple) -> tuple:
+    """The location without the union-branch labels pydantic inserts (``list[float]``, tags)."""
+    return tuple(
+        p for p in loc if not (isinstance(p, str) and (p.startswith(("list[", "function-")) or p in UNION_TAGS))
+    )
+
+
+#: pydantic's wording of a wrong type, in the words of the file
+_TYPE_RULES = {
+    "string_type": "must be a string",
+    "list_type": "must be a list",
+    "model_type": "must be a table of keys",
+    "dict_type": "must be a table of keys",
+    "model_attributes_type": "must be a table of keys",
+    "bool_type": "must be true or false",
+    "int_type": "must be an integer",
+    "float_type": "must be a number",
+}
+
+
+def _error_loc(root, error: dict) -> tuple:
+    """Where a pydantic error is, without union labels; an unknown key is kept as written (it may
+    hold brackets or any other character that a label has)."""
+    loc = tuple(error["loc"])
+    if error["type"] == "extra_forbidden" and loc:
+        return _plain_loc(clean_loc(root, loc[:-1])) + loc[-1:]
+    return _plain_loc(clean_loc(root, loc))
+
+
+#: lengths of the fixed-size lists of the schema (3-vectors, 3x3 and 6x6 matrices)
+_VECTOR_SIZES = (3, 6)
+
+
 def _from_validation_error(err: ValidationError, data: Any) -> ModelError:
     errors = err.errors()
     # an unknown key is a typo: report it first (pydantic lists the key it hides as missing first)
     first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
-    loc = clean_loc(ModelFile, tuple(first["loc"]))
+    loc = _error_loc(ModelFile, first)
     field = format_location(loc)
     value = first.get("input", _lookup(data, loc))
     kind = first["type"]
@@ -64,20 +99,44 @@ def _from_validation_error(err: ValidationError, data: Any) -> ModelError:
         return ModelError(field, value, unknown_key_rule(ModelFile, loc, where, DOC_PATH))
     if kind == "missing":
         return ModelError(field, None, f"is required (see {DOC_PATH})")
-    ctx = first.get("ctx") or {}
+    return ModelError(field, value, rule_text(first, mark_at(ModelFile, tuple(first["loc"]))))
+
+
+#: errors of a marked value, worded by its mark (range, unit, what it is)
+_MARKED = frozenset(("float_type", "finite_number", "greater_than_equal", "less_than_equal", "greater_than",
+                     "less_than", "int_type", "int_from_float", "int_parsing", "bool_type", "bool_parsing"))
+
+
+def rule_text(error: dict, mark: Any = None) -> str:
+    """The rule of one pydantic error in the words of the file (``must be a list``).
+
+    ``mark``: the :class:`~impstab.model.schema.RangeMark` (or integer or flag mark) of the value,
+    which words a wrong type or a value out of range with the range, its unit and its meaning.
+    """
+    kind = error["type"]
+    ctx = error.get("ctx") or {}
+    if mark is not None and kind in _MARKED:
+        return mark.rule(error.get("input"))
+    if kind in _TYPE_RULES:
+        return _TYPE_RULES[kind]
     if kind in ("too_short", "too_long") and "actual_length" in ctx:
         want = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
-        return ModelError(field, value, f"must have {want} items, not {ctx['actual_length']}")
-    msg = first["msg"].replace("Value error, ", "").replace("Input should be", "must be")
-    return ModelError(field, value, msg[0].lower() + msg[1:])
+        if want in _VECTOR_SIZES:  # a vector or a matrix row: its size is fixed
+            return f"must have {want} items, not {ctx['actual_length']}"
+        bound = "at least" if kind == "too_short" else "at most"
+        return f"must have {bound} {want} items, not {ctx['actual_length']}"
+    if kind in ("string_too_long", "string_too_short"):
+        return error["msg"].replace("String should have", "must have")
+    msg = error["msg"].replace("Value error, ", "").replace("Input should be", "must be")
+    return msg[0].lower() + msg[1:]
 
 
 def unit_vector(vec: list[float], field: str) -> np.ndarray:
     """``vec / |vec|``; a zero vector is a ModelError naming ``field``."""
     v = np.asarray(vec, dtype=float)
     n = float(np.linalg.norm(v))
-    if n == 0.0:
-        raise ModelError(field, vec, "must be a non-zero vector")
+    if not n >= MIN_DIRECTION:
+        raise ModelError(field, vec, f"must be a non-zero vector (length at least {MIN_DIRECTION:g})")
     return v / n
 
 
@@ -97,6 +156,9 @@ def _inertia(spec: list, field: str) -> np.ndarray:
     inertia = np.diag(arr) if arr.ndim == 1 else arr
     _symmetric_psd(inertia, field, definite=True)
     p = np.linalg.eigvalsh(inertia)
+    moments = RANGES["moment_of_inertia"]
+    if p[0] < moments.low or p[2] > moments.high:
+        raise ModelError(field, spec, f"principal moments {p.round(12).tolist()} kg m^2 must be {moments.text}")
     if p[2] > p[0] + p[1] * (1 + 1e-12):
         raise ModelError(
             field, spec, f"principal moments {p.round(12).tolist()} break the triangle inequality "
@@ -141,6 +203,8 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             mounts.append(replace(mount, rated_force=ring.rated_force, max_deflection=ring.max_deflection))
     if not mounts:
         raise ModelError("mounts", [], "the model needs at least one mount or mount ring")
+    if len(mounts) > MAX_MOUNTS:
+        raise ModelError("mounts", f"{len(mounts)} mounts", f"a model has at most {MAX_MOUNTS} mounts (mounts and ring counts together)")
     kc = elastic_stiffness(mounts)
     ev = np.linalg.eigvalsh(kc)
     if ev.min() <= 1e-9 * ev.max():
@@ -175,7 +239,13 @@ def _fluid(doc: ModelFile) -> tuple[FluidLoading, Hull | None]:
         raise ModelError("hull", None, f"is required with fluid.model = {spec.model!r} (radius, length, center)")
     if spec.density is None:
         raise ModelError("fluid.density", None, f"is required with fluid.model = {spec.model!r}")
-    return FluidLoading.from_hull(spec.model, hull, spec.density, spec.sound_speed), hull
+    try:
+        return FluidLoading.from_hull(spec.model, hull, spec.density, spec.sound_speed), hull
+    except ModelError as exc:
+        where = {"radius": "hull.radius", "length": "hull.length", "density": "fluid.density"}
+        if exc.field in where:
+            raise ModelError(where[exc.field], exc.value, exc.rule) from None
+        raise
 
 
 def _spin_speed(spec) -> float:
@@ -206,7 +276,9 @@ def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
     if thrust_max is None:
         if t.operating is None:
             raise ModelError("analysis.thrust_max", None, "is required when thrust.operating is not given")
-        thrust_max = 10.0 * t.operating
+        thrust_max = min(10.0 * t.operating, RANGES["thrust"].high)
+    # a thrust_max below the operating thrust is allowed (a search of the low range); every result
+    # of the critical-thrust search then says that it did not reach the operating point
     fluid, hull = _fluid(doc)
     return Model(
         body=body, mounts=mounts, thrust=thrust,
@@ -220,6 +292,7 @@ def model_from_dict(data: dict, name: str | None = None, source: str | None = No
     """Validate and assemble a model from the parsed contents of a model file."""
     if not isinstance(data, dict):
         raise ModelError("(file)", type(data).__name__, "must be a table of model keys")
+    check_nesting(data)
     if "schema_version" not in data:
         raise ModelError("schema_version", None, "is required (schema_version = 1)")
     try:
@@ -229,21 +302,91 @@ def model_from_dict(data: dict, name: str | None = None, source: str | None = No
     return _assemble(doc, doc.name or name or "model", source)
 
 
-def read_toml(path: str | os.PathLike[str], what: str = "model file") -> dict:
-    """Read a TOML file, turning every I/O or syntax problem into a one-line ModelError."""
+def check_nesting(data: Any, limit: int = MAX_NESTING, max_items: int | None = MAX_LIST_ITEMS) -> None:
+    """ModelError when tables and arrays nest deeper than ``limit``, or an array holds more than
+    ``max_items`` values (checked without recursion, before the schema sees the data)."""
+    stack: list[tuple[Any, int, tuple]] = [(data, 0, ())]
+    while stack:
+        value, depth, loc = stack.pop()
+        if depth > limit:
+            raise ModelError(format_location(loc[:2]), _lookup(data, loc[:2]),
+                             f"tables and arrays may nest at most {limit} levels deep")
+        if isinstance(value, dict):
+            items = value.items()
+        else:
+            if max_items is not None and len(value) > max_items:
+                raise ModelError(format_location(loc) if loc else "(file)", f"{len(value)} items",
+                                 f"an array may hold at most {max_items} items")
+            items = enumerate(value)
+        for key, item in items:
+            if isinstance(item, (dict, list)):
+                stack.append((item, depth + 1, loc + (key,)))
+
+
+def read_text(path: str | os.PathLike[str], what: str = "model file") -> str:
+    """The UTF-8 text of a regular file of at most :data:`~impstab.limits.MAX_FILE_BYTES`.
+
+    A FIFO, a device, a socket or a directory is refused without being read (the file is
+    opened non-blocking and checked with ``fstat`` before a byte is read); a larger file is
+    refused after reading at most one byte more than the limit.
+    """
     p = Path(path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_BINARY", 0)
     try:
-        text = p.read_bytes().decode("utf-8")
+        fd = os.open(p, flags)
     except FileNotFoundError:
         raise ModelError(what, str(p), "file not found") from None
     except IsADirectoryError:
         raise ModelError(what, str(p), "is a directory, not a file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ModelError(what, str(p), f"cannot be read ({exc.__class__.__name__}: {exc})") from None
+    except PermissionError:
+        raise ModelError(what, str(p), "cannot be read (permission denied)") from None
+    except (OSError, ValueError) as exc:
+        reason = getattr(exc, "strerror", None) or exc.__class__.__name__
+        raise ModelError(what, str(p), f"cannot be read ({reason})") from None
     try:
-        return tomllib.loads(text)
+        info = os.fstat(fd)
+        if stat.S_ISDIR(info.st_mode):
+            raise ModelError(what, str(p), "is a directory, not a file")
+        if not stat.S_ISREG(info.st_mode):
+            raise ModelError(what, str(p), "is not a regular file (a pipe, a device or a socket): give a TOML file")
+        limit = f"larger than the {MAX_FILE_BYTES // 1024**2} MiB a {what} may have"
+        if info.st_size > MAX_FILE_BYTES:
+            raise ModelError(what, str(p), f"is {info.st_size} bytes, {limit}")
+        chunks = []
+        size = 0
+        while size <= MAX_FILE_BYTES:
+            chunk = os.read(fd, min(1 << 20, MAX_FILE_BYTES + 1 - size))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        if size > MAX_FILE_BYTES:
+            raise ModelError(what, str(p), f"is {limit}")
+    except OSError as exc:
+        raise ModelError(what, str(p), f"cannot be read ({exc.strerror or exc.__class__.__name__})") from None
+    finally:
+        os.close(fd)
+    try:
+        return b"".join(chunks).decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ModelError(what, str(p), f"is not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset {exc.start})") from None
+
+
+def parse_toml(text: str, path: str | os.PathLike[str], what: str = "model file", max_items: int | None = MAX_LIST_ITEMS) -> dict:
+    """Parse TOML text, turning a syntax error or too deep a nesting into a one-line ModelError."""
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ModelError(what, str(p), f"is not valid TOML ({exc})") from None
+        raise ModelError(what, str(path), f"is not valid TOML ({exc})") from None
+    except RecursionError:
+        raise ModelError(what, str(path), f"is nested too deeply (tables and arrays at most {MAX_NESTING} levels)") from None
+    check_nesting(data, max_items=max_items)
+    return data
+
+
+def read_toml(path: str | os.PathLike[str], what: str = "model file") -> dict:
+    """Read a TOML file, turning every I/O or syntax problem into a one-line ModelError."""
+    return parse_toml(read_text(path, what), path, what)
 
 
 def load_model(path: str | os.PathLike[str]) -> Model:

@@ -1,6 +1,12 @@
 """Model file schema (TOML, ``schema_version = 1``, SI units): pydantic at the file boundary only.
 
-The schema checks types, shapes, signs and finiteness and rejects unknown keys (they are typos).
+The schema checks types, shapes, ranges and finiteness and rejects unknown keys (they are typos).
+Types are strict: a number is an integer or a float literal (never ``true`` or ``"100"``), a flag
+is ``true`` or ``false`` (never ``1`` or ``"off"``), an integer is an integer literal (``3``, not
+``3.0``). Every magnitude has the physical range of :data:`impstab.limits.RANGES`, carried as the
+``minimum`` / ``maximum`` of its JSON schema (so the model-file reference shows it) and checked
+with a message that names the range and its unit.
+
 Physical rules that involve several values (positive-definite inertia, restrained mounts, ...)
 are checked when the validated file is assembled into a :class:`~impstab.model.Model`
 (:mod:`impstab.model.assemble`).
@@ -8,20 +14,196 @@ are checked when the validated file is assembled into a :class:`~impstab.model.M
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Optional, Union
+import types
+import typing
+from typing import Annotated, Any, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator
 
-__all__ = ["ModelFile", "MountSpec", "MountRingSpec"]
+from ..limits import MAX_MOUNTS, MAX_TEXT, RANGES, as_boolean, as_integer
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+__all__ = ["ModelFile", "MountSpec", "MountRingSpec", "number", "integer", "mark_at", "RangeMark", "UNION_TAGS"]
+
+
+class RangeMark:
+    """Marks a number of the schema with its range of :data:`impstab.limits.RANGES`.
+
+    Validation itself runs in pydantic-core (strict float, ``ge``/``le``, no inf/nan: no Python
+    call per number); the mark only words a failure: :func:`impstab.model.assemble.rule_text`
+    finds it at the error's location and names the range, its unit and what it is.
+    """
+
+    __slots__ = ("kind",)
+
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+
+    def rule(self, value: object) -> str:
+        try:
+            RANGES[self.kind].validate(value)
+        except ValueError as exc:
+            return str(exc)
+        return RANGES[self.kind].rule()
+
+
+class IntegerMark:
+    """Marks an integer of the schema with its range and meaning (see :class:`RangeMark`)."""
+
+    __slots__ = ("low", "high", "what")
+
+    def __init__(self, low: int | None = None, high: int | None = None, what: str = "") -> None:
+        self.low, self.high, self.what = low, high, what
+
+    def rule(self, value: object) -> str:
+        try:
+            n = as_integer(value)
+        except ValueError as exc:
+            return str(exc)
+        if self.low is not None and self.high is not None:
+            return f"must be an integer between {self.low} and {self.high} ({self.what})"
+        return f"must be an integer (not {n})"
+
+
+class FlagMark:
+    """Marks a flag of the schema (see :class:`RangeMark`)."""
+
+    __slots__ = ()
+
+    def rule(self, value: object) -> str:
+        try:
+            as_boolean(value)
+        except ValueError as exc:
+            return str(exc)
+        return "must be true or false"
+
+
+def number(kind: str) -> Any:
+    """A strict float in the range ``RANGES[kind]`` (integers are numbers; booleans, strings are not)."""
+    r = RANGES[kind]
+    return Annotated[float, Field(ge=r.low, le=r.high, strict=True, allow_inf_nan=False), RangeMark(kind)]
+
+
+# -- the type aliases every key uses (strict, ranged) ------------------------------------------
+Finite = number("number")                 # any finite number within +-1e15
+Positive = number("positive")             # 1e-12 ... 1e15
+NonNegative = number("nonnegative")       # 0 ... 1e15
+Integer = Annotated[int, Field(strict=True), IntegerMark()]  # 3, never 3.0 or true
+Flag = Annotated[bool, Field(strict=True), FlagMark()]
+Text = Annotated[str, Field(strict=True, max_length=MAX_TEXT)]
+StrictFloat, StrictInt, StrictBool = Finite, Integer, Flag
+
+
+
+def integer(low: int, high: int, what: str) -> Any:
+    """A strict integer in ``[low, high]`` (``3.0``, ``true`` and ``"3"`` are not integers)."""
+    return Annotated[int, Field(ge=low, le=high, strict=True), IntegerMark(low, high, what)]
+
+
+def mark_at(root: type[BaseModel], loc: tuple) -> Any:
+    """The :class:`RangeMark`, :class:`IntegerMark` or :class:`FlagMark` of the value at ``loc``
+    (a pydantic error location: keys, list indices, union labels and tags), or None."""
+    tp: Any = root
+    for part in loc:
+        core, _ = _strip(tp)
+        if isinstance(part, int):
+            core = _list_branch(core)
+            if typing.get_origin(core) is not list:
+                return None
+            tp = typing.get_args(core)[0]
+        elif isinstance(core, type) and issubclass(core, BaseModel):
+            info = core.model_fields.get(part)
+            if info is None:
+                return None
+            tp = Annotated[(info.annotation, *info.metadata)] if info.metadata else info.annotation
+        elif typing.get_origin(core) in (Union, types.UnionType):
+            tagged = [a for a in typing.get_args(core) if any(isinstance(m, Tag) and m.tag == part for m in _strip(a)[1])]
+            if tagged:
+                tp = tagged[0]
+            # else: a label pydantic inserts for a union branch ("list[float]"): the index that
+            # follows picks the list branch
+        # else: a label on a plain value (a validator's name): nothing to descend into
+    _, meta = _strip(tp)
+    return next((m for m in meta if isinstance(m, (RangeMark, IntegerMark, FlagMark))), None)
+
+
+def _strip(tp: Any) -> tuple[Any, list]:
+    """Remove ``Optional`` and ``Annotated`` wrappers; returns the core type and the metadata."""
+    meta: list = []
+    while True:
+        origin = typing.get_origin(tp)
+        if origin is Annotated:
+            meta.extend(tp.__metadata__)
+            tp = tp.__origin__
+        elif origin in (Union, types.UnionType):
+            args = [a for a in typing.get_args(tp) if a is not type(None)]
+            if len(args) != 1:
+                return tp, meta
+            tp = args[0]
+        else:
+            return tp, meta
+
+
+def _list_branch(core: Any) -> Any:
+    if typing.get_origin(core) in (Union, types.UnionType):
+        for arg in typing.get_args(core):
+            inner, _ = _strip(arg)
+            if typing.get_origin(inner) is list:
+                return inner
+    return core
+
+
+# physical magnitudes (SI units; ranges and reasons in docs/limits.md)
+Mass = number("mass")                     # kg
+Moment = number("moment_of_inertia")      # kg m^2, a principal moment
+InertiaEntry = number("inertia_entry")    # kg m^2, an entry of the inertia tensor
+PolarInertia = number("polar_inertia")    # kg m^2
+Coordinate = number("coordinate")         # m, a point in the body frame
+Size = number("size")                     # m, a radius or a length (> 0)
+Component = number("direction")           # a component of a direction or axis vector
+Angle = number("angle")                   # degrees
+Stiffness = number("stiffness")           # N/m
+Damping = number("damping")               # N s/m
+Thrust = number("thrust")                 # N
+Fraction = number("fraction")             # 0 ... 1
+SpinSpeed = number("spin_speed")          # rad/s
+SpinSpeedRpm = number("spin_speed_rpm")   # rpm
+Density = number("density")               # kg/m^3
+SoundSpeed = number("sound_speed")        # m/s
+
 Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+Point3 = Annotated[list[Coordinate], Field(min_length=3, max_length=3)]
+Direction3 = Annotated[list[Component], Field(min_length=3, max_length=3)]
 Row6 = Annotated[list[Finite], Field(min_length=6, max_length=6)]
 Mat6 = Annotated[list[Row6], Field(min_length=6, max_length=6)]
 Row3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
 Mat3 = Annotated[list[Row3], Field(min_length=3, max_length=3)]
+
+
+def _matrix6(kind: str) -> Any:
+    row = Annotated[list[number(kind)], Field(min_length=6, max_length=6)]  # type: ignore[misc]
+    return Annotated[list[row], Field(min_length=6, max_length=6)]
+
+
+Stiffness6 = _matrix6("stiffness_entry")
+Damping6 = _matrix6("damping_entry")
+AddedMass6 = _matrix6("added_mass_entry")
+Moments3 = Annotated[list[Moment], Field(min_length=3, max_length=3)]
+Tensor3 = Annotated[list[Annotated[list[InertiaEntry], Field(min_length=3, max_length=3)]], Field(min_length=3, max_length=3)]
+
+#: labels of the branches of a union of list shapes (left out of the field names in messages)
+UNION_TAGS = ("principal moments", "tensor")
+
+
+def _inertia_shape(value: Any) -> str:
+    if isinstance(value, list) and value and all(isinstance(row, list) for row in value):
+        return "tensor"
+    return "principal moments"
+
+
+Inertia = Annotated[
+    Union[Annotated[Moments3, Tag("principal moments")], Annotated[Tensor3, Tag("tensor")]],
+    Discriminator(_inertia_shape),
+]
 
 
 class _Strict(BaseModel):
@@ -29,68 +211,68 @@ class _Strict(BaseModel):
 
 
 class BodySpec(_Strict):
-    mass: Positive
-    cg: Vec3 = [0.0, 0.0, 0.0]
-    inertia: Union[Vec3, Mat3]
+    mass: Mass
+    cg: Point3 = [0.0, 0.0, 0.0]
+    inertia: Inertia
 
 
 class HullSpec(_Strict):
-    radius: Positive
-    length: Positive
-    center: Vec3 = [0.0, 0.0, 0.0]
+    radius: Size
+    length: Size
+    center: Point3 = [0.0, 0.0, 0.0]
 
 
 class FluidSpec(_Strict):
     model: Literal["none", "baffled-cylinder", "strip", "matrix"] = "none"
-    density: Optional[Positive] = None
-    sound_speed: Optional[Positive] = None
-    added_mass: Optional[Mat6] = None
+    density: Optional[Density] = None
+    sound_speed: Optional[SoundSpeed] = None
+    added_mass: Optional[AddedMass6] = None
 
 
 class MountSpec(_Strict):
-    position: Vec3
-    axis: Vec3 = [1.0, 0.0, 0.0]
-    k_axial: Optional[NonNegative] = None
-    k_shear: Optional[NonNegative] = None
-    c_axial: NonNegative = 0.0
-    c_shear: NonNegative = 0.0
-    stiffness: Optional[Mat6] = None
-    damping: Optional[Mat6] = None
+    position: Point3
+    axis: Direction3 = [1.0, 0.0, 0.0]
+    k_axial: Optional[Stiffness] = None
+    k_shear: Optional[Stiffness] = None
+    c_axial: Damping = 0.0
+    c_shear: Damping = 0.0
+    stiffness: Optional[Stiffness6] = None
+    damping: Optional[Damping6] = None
     rated_force: Optional[Positive] = None      # N, static force rating (isolation design)
     max_deflection: Optional[Positive] = None   # m, static deflection limit
 
 
 class MountRingSpec(_Strict):
-    count: Annotated[int, Field(ge=1, le=1000)]
-    radius: Positive
-    x: Finite = 0.0
-    start_angle: Finite = 0.0
-    axis: Vec3 = [1.0, 0.0, 0.0]
-    k_axial: NonNegative
-    k_shear: NonNegative
-    c_axial: NonNegative = 0.0
-    c_shear: NonNegative = 0.0
+    count: integer(1, MAX_MOUNTS, "mounts on the ring")  # type: ignore[valid-type]
+    radius: Size
+    x: Coordinate = 0.0
+    start_angle: Angle = 0.0
+    axis: Direction3 = [1.0, 0.0, 0.0]
+    k_axial: Stiffness
+    k_shear: Stiffness
+    c_axial: Damping = 0.0
+    c_shear: Damping = 0.0
     rated_force: Optional[Positive] = None      # N, static force rating (isolation design)
     max_deflection: Optional[Positive] = None   # m, static deflection limit
 
 
 class ThrustSpec(_Strict):
-    point: Vec3 = [0.0, 0.0, 0.0]
-    direction: Vec3 = [1.0, 0.0, 0.0]
-    tangency: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 1.0
-    operating: Optional[Positive] = None
-    preload_stiffness: bool = True
+    point: Point3 = [0.0, 0.0, 0.0]
+    direction: Direction3 = [1.0, 0.0, 0.0]
+    tangency: Fraction = 1.0
+    operating: Optional[Thrust] = None
+    preload_stiffness: Flag = True
 
 
 class PropellerSpec(_Strict):
-    polar_inertia: NonNegative = 0.0
-    speed: Finite = 0.0
-    speed_rpm: Optional[Finite] = None  # rpm, instead of speed (rad/s)
+    polar_inertia: PolarInertia = 0.0
+    speed: SpinSpeed = 0.0
+    speed_rpm: Optional[SpinSpeedRpm] = None  # rpm, instead of speed (rad/s)
     speed_law: Literal["constant", "sqrt-thrust"] = "constant"
 
 
 class AnalysisSpec(_Strict):
-    thrust_max: Optional[Positive] = None
+    thrust_max: Optional[Thrust] = None
     linearization: Literal["equilibrium", "classical"] = "equilibrium"
 
 
@@ -146,13 +328,13 @@ class FoundationSpec(_Strict):
 class ModelFile(_Strict):
     """The whole model file."""
 
-    schema_version: int
-    name: Optional[str] = None
+    schema_version: Annotated[Integer, Field(json_schema_extra={"minimum": 1, "maximum": 1})]
+    name: Optional[Text] = None
     body: BodySpec
     hull: Optional[HullSpec] = None
     fluid: Optional[FluidSpec] = None
-    mounts: list[MountSpec] = []
-    mount_rings: list[MountRingSpec] = []
+    mounts: Annotated[list[MountSpec], Field(max_length=MAX_MOUNTS)] = []
+    mount_rings: Annotated[list[MountRingSpec], Field(max_length=MAX_MOUNTS)] = []
     thrust: ThrustSpec = ThrustSpec()
     propeller: Optional[PropellerSpec] = None
     analysis: AnalysisSpec = AnalysisSpec()

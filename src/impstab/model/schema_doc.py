@@ -126,7 +126,7 @@ def _number_rule(frag: dict) -> list[str]:
 
 
 def _num(v: Any) -> str:
-    if isinstance(v, float) and v.is_integer() and abs(v) < 1e15:
+    if isinstance(v, float) and v.is_integer() and abs(v) < 1e6:  # larger bounds read better as 1e+13
         return str(int(v))
     return f"{v:g}" if isinstance(v, float) else str(v)
 
@@ -134,8 +134,8 @@ def _num(v: Any) -> str:
 def _describe(frag: dict, defs: dict) -> tuple[str, list[str]]:
     """``(type in words, rules)`` of a JSON-schema fragment."""
     frag = _resolve(frag, defs)
-    if "anyOf" in frag:
-        parts = [_describe(f, defs) for f in frag["anyOf"] if _resolve(f, defs).get("type") != "null"]
+    if "anyOf" in frag or "oneOf" in frag:  # oneOf: a union told apart by the value's shape
+        parts = [_describe(f, defs) for f in frag.get("anyOf", frag.get("oneOf")) if _resolve(f, defs).get("type") != "null"]
         types_ = list(dict.fromkeys(p[0] for p in parts))
         rules = list(dict.fromkeys(r for p in parts for r in p[1]))
         if len(types_) > 1 and all(t in _SCALARS for t in types_):

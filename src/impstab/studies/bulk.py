@@ -27,6 +27,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from ..limits import RANGES
 from ..linear.batch import AffineDesign
 from ..linear.linearize import ModelFamily, affine_forms, pack_model
 from ..model.assemble import model_from_dict, unit_vector
@@ -143,7 +144,7 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
             stiffness[:, i, :3, :3] = axial_shear_matrix(unit_vector(mount.axis, f"mounts[{i}].axis"), get("k_axial"), get("k_shear"))
     operating = values.get(("thrust", "operating"), np.full(n, np.nan if pk.operating is None else pk.operating))
     t_max = doc.analysis.thrust_max
-    thrust_max = np.full(n, float(t_max)) if t_max is not None else 10.0 * operating
+    thrust_max = np.full(n, float(t_max)) if t_max is not None else np.minimum(10.0 * operating, RANGES["thrust"].high)
     arms = np.concatenate([np.linalg.norm(positions, axis=-1), np.full((n, 1), np.linalg.norm(pk.r_thrust))], axis=1)
     length_scale = np.maximum(arms.max(axis=1), 1e-3)
     # the model rule "the mounts restrain all six motions", on the condensed stiffness

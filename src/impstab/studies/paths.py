@@ -18,7 +18,8 @@ from typing import Annotated, Any, Literal, Union
 import numpy as np
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
-from ..model.schema import ModelFile
+from ..model.assemble import rule_text
+from ..model.schema import FlagMark, IntegerMark, ModelFile, RangeMark
 
 __all__ = ["ParameterPath", "parse_path", "resolve_path", "set_values", "variant_dict"]
 
@@ -101,14 +102,14 @@ class ParameterPath:
     kind: str
     choices: tuple[str, ...]
     adapter: TypeAdapter
+    mark: Any = None
 
     def check(self, value: Any) -> Any:
         """The value as the schema accepts it; ValueError with the schema's rule otherwise."""
         try:
             return self.adapter.validate_python(value)
         except ValidationError as err:
-            msg = err.errors()[0]["msg"].replace("Input should be", "must be")
-            raise ValueError(msg[0].lower() + msg[1:]) from None
+            raise ValueError(rule_text(err.errors()[0], self.mark)) from None
 
 
 def resolve_path(path: str, base: dict) -> ParameterPath:
@@ -164,7 +165,8 @@ def resolve_path(path: str, base: dict) -> ParameterPath:
             "number, e.g. mounts[0].position[1]"
         )
     adapter = TypeAdapter(Annotated[(core, *meta)] if meta else core)
-    return ParameterPath(path, segments, kind, choices, adapter)
+    mark = next((m for m in meta if isinstance(m, (RangeMark, IntegerMark, FlagMark))), None)
+    return ParameterPath(path, segments, kind, choices, adapter, mark)
 
 
 def set_values(base: dict, paths: list, values: list[Any]) -> dict:

@@ -34,9 +34,13 @@ designs for ``d`` parameters, from the same distributions.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Optional, Union
+from typing import Annotated, Any, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr, field_validator
+from pydantic import (BaseModel, ConfigDict, Discriminator, Field, StrictBool, StrictFloat, StrictInt, StrictStr, Tag,
+                      field_validator)
+
+from ..limits import MAX_TEXT
+from ..model.schema import Finite, Integer, Positive, Text, integer
 
 __all__ = ["StudyFile", "ParameterSpec", "RangeSpec", "DistributionSpec", "OUTPUTS", "DEFAULT_OUTPUTS"]
 
@@ -55,8 +59,10 @@ OUTPUTS = {
 }
 DEFAULT_OUTPUTS = ("critical_thrust", "kind", "frequency_hz", "margin", "undamped_critical_thrust")
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Scalar = Union[StrictBool, StrictInt, StrictFloat, StrictStr]
+#: one value of a list of values: checked against the rule of its parameter's field later
+Scalar = Union[StrictBool, StrictInt, StrictFloat, Annotated[StrictStr, Field(max_length=MAX_TEXT)]]
+#: most values of one parameter (a list, or ``num`` of a range)
+MAX_VALUES = 10_000_000
 
 
 class _Strict(BaseModel):
@@ -68,7 +74,7 @@ class RangeSpec(_Strict):
 
     start: Finite
     stop: Finite
-    num: Optional[Annotated[int, Field(ge=1, le=10_000_000)]] = None
+    num: Optional[integer(1, MAX_VALUES, "grid values of one parameter")] = None  # type: ignore[valid-type]
     scale: Literal["linear", "log"] = "linear"
 
 
@@ -79,33 +85,48 @@ class DistributionSpec(_Strict):
     low: Optional[Finite] = None
     high: Optional[Finite] = None
     mean: Optional[Finite] = None
-    std: Optional[Annotated[float, Field(gt=0, allow_inf_nan=False)]] = None
-    median: Optional[Annotated[float, Field(gt=0, allow_inf_nan=False)]] = None
-    sigma: Optional[Annotated[float, Field(gt=0, allow_inf_nan=False)]] = None
+    std: Optional[Positive] = None
+    median: Optional[Positive] = None
+    sigma: Optional[Positive] = None
+
+
+#: labels of the two shapes of ``values`` (left out of the field names in messages)
+VALUES_TAGS = ("range", "value list")
+
+
+def _values_shape(value: Any) -> str:
+    return "range" if isinstance(value, (dict, RangeSpec)) else "value list"
+
+
+ValuesSpec = Annotated[
+    Union[Annotated[RangeSpec, Tag("range")],
+          Annotated[list[Scalar], Field(min_length=1, max_length=MAX_VALUES), Tag("value list")]],
+    Discriminator(_values_shape),
+]
 
 
 class ParameterSpec(_Strict):
-    path: str
-    values: Optional[Union[RangeSpec, Annotated[list[Scalar], Field(min_length=1)]]] = None
+    path: Text
+    values: Optional[ValuesSpec] = None
     distribution: Optional[DistributionSpec] = None
 
 
 class SamplingSpec(_Strict):
     method: Literal["grid", "random", "sobol", "saltelli"] = "grid"
-    n: Optional[Annotated[int, Field(ge=1, le=100_000_000)]] = None
-    seed: Annotated[int, Field(ge=0)] = 0
+    n: Optional[integer(1, 100_000_000, "samples (base samples with saltelli)")] = None  # type: ignore[valid-type]
+    seed: integer(0, 2**63 - 1, "a seed") = 0  # type: ignore[valid-type]
 
 
 class ExecutionSpec(_Strict):
-    chunk_size: Annotated[int, Field(ge=1, le=1_000_000)] = 1024
+    chunk_size: integer(1, 1_000_000, "designs per chunk") = 1024  # type: ignore[valid-type]
 
 
 class StudyFile(_Strict):
     """The whole study file."""
 
-    schema_version: int
-    name: Optional[str] = None
-    model: str
+    schema_version: Integer
+    name: Optional[Text] = None
+    model: Text
     outputs: Annotated[list[Literal[tuple(OUTPUTS)]], Field(min_length=1)] = list(DEFAULT_OUTPUTS)  # type: ignore[valid-type]
     parameters: Annotated[list[ParameterSpec], Field(min_length=1, max_length=32)]
     sampling: SamplingSpec = SamplingSpec()

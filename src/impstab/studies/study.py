@@ -21,17 +21,23 @@ from numpy.typing import NDArray
 from pydantic import ValidationError
 
 from ..errors import ModelError
-from ..model.assemble import format_location, model_from_dict, read_toml
-from ..model.schema_doc import clean_loc, unknown_key_rule
+from ..limits import MAX_STUDY_BYTES
+from ..model.assemble import _error_loc, check_nesting, format_location, model_from_dict, parse_toml, read_text, rule_text
+from ..model.schema import mark_at
+from ..model.schema_doc import unknown_key_rule
 from .paths import ParameterPath, resolve_path
-from .sampling import axis_values, check_distribution, map_samples, unit_samples
 from .reference import DOC_PATH as STUDY_DOC_PATH
-from .schema import ParameterSpec, RangeSpec, StudyFile
+from .sampling import axis_values, check_distribution, map_samples, unit_samples
+from .schema import VALUES_TAGS, ParameterSpec, RangeSpec, StudyFile
 
-__all__ = ["Study", "Parameter", "load_study", "study_from_dict", "describe", "MAX_DESIGNS"]
+__all__ = ["Study", "Parameter", "load_study", "study_from_dict", "describe", "MAX_DESIGNS", "result_bytes"]
 
 #: largest number of designs in one study
 MAX_DESIGNS = 100_000_000
+#: bytes per design of each output in memory (floats 8, kind codes 1, "modes" up to 36 characters
+#: of 4 bytes), and of the status code and the message (an object pointer) of every design
+_OUTPUT_BYTES = {"kind": 1, "undamped_kind": 1, "modes": 144}
+_DESIGN_BYTES = 1 + 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,7 +115,7 @@ def _schema_error(err: ValidationError) -> ModelError:
     errors = err.errors()
     # an unknown key is a typo: report it first (pydantic lists the key it hides as missing first)
     first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
-    loc = clean_loc(StudyFile, tuple(first["loc"]))
+    loc = tuple(p for p in _error_loc(StudyFile, first) if p not in VALUES_TAGS)
     field = format_location(loc)
     kind = first["type"]
     if kind == "extra_forbidden":
@@ -117,23 +123,51 @@ def _schema_error(err: ValidationError) -> ModelError:
         return ModelError(field, first.get("input"), unknown_key_rule(StudyFile, loc, where, STUDY_DOC_PATH))
     if kind == "missing":
         return ModelError(field, None, f"is required (see {STUDY_DOC_PATH})")
-    msg = first["msg"].replace("Value error, ", "").replace("Input should be", "must be")
-    return ModelError(field, first.get("input"), msg[0].lower() + msg[1:])
+    return ModelError(field, first.get("input"), rule_text(first, mark_at(StudyFile, tuple(first["loc"]))))
+
+
+def result_bytes(n_designs: int, n_parameters: int, outputs: tuple[str, ...] | list[str], grid: bool) -> int:
+    """Estimated memory of a study's results (bytes): every output, status and message of every
+    design, and the parameter values (one axis each for a grid, one column each otherwise)."""
+    per_design = _DESIGN_BYTES + sum(_OUTPUT_BYTES.get(name, 8) for name in outputs)
+    return n_designs * (per_design + (0 if grid else 8 * n_parameters))
 
 
 def _checked(par: ParameterPath, values: list, field: str) -> NDArray:
-    """Values converted by the field's schema rule, as an array of the field's type."""
+    """Values checked with the field's strict schema rule, as an array of the field's type.
+
+    A list is taken as written: ``[true, false]`` is not a list of numbers and ``[3.0, 4.0]``
+    not a list of integers (a range of an integer field gives integers itself).
+    """
     out = []
     for v in values:
         v = v.item() if isinstance(v, np.generic) else v
-        if par.kind == "int" and isinstance(v, float) and v.is_integer():
-            v = int(v)
         try:
             out.append(par.check(v))
         except ValueError as exc:
             raise ModelError(field, v, f"{exc} (the rule of {par.path})") from None
     dtype = {"float": np.float64, "int": np.int64, "bool": np.bool_, "str": np.str_}[par.kind]
     return np.asarray(out, dtype=dtype)
+
+
+def _checked_array(par: ParameterPath, values: NDArray, field: str) -> NDArray:
+    """A generated column (a range, samples of a distribution) checked with the field's rule.
+
+    The rule of a numeric field is a range, so the smallest and the largest value decide; a
+    non-finite value (an infinite quantile) is reported first.
+    """
+    arr = np.asarray(values)
+    if arr.size == 0:
+        return arr
+    if arr.dtype.kind == "f" and not np.isfinite(arr).all():
+        bad = arr[~np.isfinite(arr)][0]
+        raise ModelError(field, float(bad), f"must be a finite number (the rule of {par.path})")
+    for v in (arr.min(), arr.max()):
+        try:
+            par.check(v.item())
+        except ValueError as exc:
+            raise ModelError(field, v.item(), f"{exc} (the rule of {par.path})") from None
+    return arr.astype(np.int64 if par.kind == "int" else np.float64)
 
 
 def _grid_axis(spec: ParameterSpec, par: ParameterPath, i: int) -> NDArray:
@@ -148,14 +182,17 @@ def _grid_axis(spec: ParameterSpec, par: ParameterPath, i: int) -> NDArray:
         axis = axis_values(spec)
     except ValueError as exc:
         raise ModelError(f"{f}.values", _shown(spec.values), str(exc)) from None
-    if par.kind == "int" and isinstance(spec.values, RangeSpec):
-        rounded = np.round(axis)
-        if not np.allclose(axis, rounded, rtol=0, atol=1e-9 * max(1.0, np.abs(axis).max())):
-            raise ModelError(f"{f}.values", _shown(spec.values), f"{par.path} is an integer: the range must hit integers (or give a list)")
-        axis = rounded.astype(np.int64).tolist()
-    elif isinstance(axis, np.ndarray):
-        axis = axis.tolist()
-    values = _checked(par, axis, f"{f}.values")
+    if isinstance(spec.values, RangeSpec):
+        if par.kind not in ("float", "int"):
+            raise ModelError(f"{f}.values", _shown(spec.values), f"{par.path} is not a number: give a list of values")
+        if par.kind == "int":
+            rounded = np.round(axis)
+            if not np.allclose(axis, rounded, rtol=0, atol=1e-9 * max(1.0, np.abs(axis).max())):
+                raise ModelError(f"{f}.values", _shown(spec.values), f"{par.path} is an integer: the range must hit integers (or give a list)")
+            axis = rounded.astype(np.int64)
+        values = _checked_array(par, axis, f"{f}.values")
+    else:
+        values = _checked(par, axis, f"{f}.values")
     if len(np.unique(values)) != len(values):
         raise ModelError(f"{f}.values", axis if len(axis) < 12 else f"{len(axis)} values", "must be distinct")
     return values
@@ -169,8 +206,8 @@ def _sample_column(spec: ParameterSpec, par: ParameterPath, i: int, u: NDArray) 
         key = "distribution" if spec.distribution is not None else "values"
         raise ModelError(f"{f}.{key}", _shown(getattr(spec, key)), str(exc)) from None
     if isinstance(spec.values, list):
-        _checked(par, spec.values, f"{f}.values")
-        return _checked(par, map_samples(spec, u), f"{f}.values")
+        dtype = _checked(par, spec.values, f"{f}.values").dtype
+        return np.asarray(map_samples(spec, u), dtype=dtype)
     if par.kind != "float":
         raise ModelError(f"{f}.values", par.kind, f"{par.path} is not a real number: give a list of values to draw from")
     ends = []
@@ -178,8 +215,9 @@ def _sample_column(spec: ParameterSpec, par: ParameterPath, i: int, u: NDArray) 
         ends = [spec.values.start, spec.values.stop]
     elif spec.distribution.low is not None:
         ends = [spec.distribution.low, spec.distribution.high]
-    _checked(par, ends, f"{f}.{'values' if spec.values is not None else 'distribution'}")
-    return np.asarray(map_samples(spec, u), dtype=np.float64)
+    key = f"{f}.{'values' if spec.values is not None else 'distribution'}"
+    _checked(par, ends, key)
+    return _checked_array(par, np.asarray(map_samples(spec, u), dtype=np.float64), key)
 
 
 def study_from_dict(
@@ -198,6 +236,7 @@ def study_from_dict(
     """
     if not isinstance(data, dict):
         raise ModelError("(study file)", type(data).__name__, "must be a table of study keys")
+    check_nesting(data, max_items=None)
     if "schema_version" not in data:
         raise ModelError("schema_version", None, "is required (schema_version = 1)")
     try:
@@ -206,7 +245,8 @@ def study_from_dict(
         raise _schema_error(err) from None
     model_path = Path(base_dir) / doc.model
     try:
-        base = read_toml(model_path, "model")
+        model_text = read_text(model_path, "model")
+        base = parse_toml(model_text, model_path, "model")
     except ModelError as err:
         raise ModelError("model", doc.model, f"{err.rule} ({model_path})") from None
     try:
@@ -236,6 +276,14 @@ def study_from_dict(
         size = design_count(method, doc.sampling.n, len(paths))
     if size > MAX_DESIGNS:
         raise ModelError("parameters", f"{size} designs", f"more than {MAX_DESIGNS} designs in one study")
+    needed = result_bytes(size, len(paths), doc.outputs, method == "grid")
+    if needed > MAX_STUDY_BYTES:
+        where = "sampling.n" if method != "grid" else "parameters"
+        raise ModelError(
+            where, f"{size} designs",
+            f"the results of {size} designs with {len(doc.outputs)} outputs would take about "
+            f"{needed / 1024**3:.3g} GiB (limit {MAX_STUDY_BYTES / 1024**3:g} GiB): fewer designs or outputs",
+        )
     if method != "grid":
         u = unit_samples(method, size, len(paths), doc.sampling.seed)
         columns = [_sample_column(s, p, i, u[:, i]) for i, (s, p) in enumerate(zip(doc.parameters, paths))]
@@ -249,7 +297,7 @@ def study_from_dict(
         base_model=base,
         model_name=model.name,
         study_text=text if text is not None else json.dumps(data, default=str),
-        model_text=model_path.read_text(encoding="utf-8"),
+        model_text=model_text,
         fingerprint=hashlib.sha256(canonical.encode()).hexdigest(),
         source=source,
         model_source=str(model_path),
@@ -266,8 +314,8 @@ def load_study(path: str | os.PathLike[str]) -> Study:
         One line naming the field, the value and the rule; nothing has run and nothing is written.
     """
     p = Path(path)
-    data = read_toml(p, "study file")
-    text = p.read_text(encoding="utf-8")
+    text = read_text(p, "study file")
+    data = parse_toml(text, p, "study file", max_items=None)
     return study_from_dict(data, p.parent, source=str(p), text=text)
 
 
