@@ -18,7 +18,8 @@ def _values(store):
 def test_local_cluster_of_worker_processes_equals_in_process(tmp_path, capsys):
     path = write_study(tmp_path, GRID_6x5, chunk_size=5)
     run_study(load_study(path), tmp_path / "local.zarr")
-    code = main(["sweep", str(path), "-o", str(tmp_path / "dask.zarr"), "--workers", "2", "--no-progress"])
+    code = main(["sweep", str(path), "-o", str(tmp_path / "dask.zarr"), "--workers", "2", "--no-progress",
+                 "--min-dask-designs", "0"])
     assert code == 0, capsys.readouterr().err
     assert _values(tmp_path / "dask.zarr").identical(_values(tmp_path / "local.zarr"))
     history = open_study(tmp_path / "dask.zarr").dataset.attrs["history"]
@@ -31,7 +32,7 @@ def test_existing_scheduler_by_address(tmp_path, capsys):
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
                                   silence_logs=logging.ERROR) as cluster:
         code = main(["sweep", str(path), "-o", str(tmp_path / "remote.zarr"), "--scheduler", cluster.scheduler_address,
-                     "--no-progress"])
+                     "--no-progress", "--min-dask-designs", "0"])
     assert code == 0, capsys.readouterr().err
     assert _values(tmp_path / "remote.zarr").identical(_values(tmp_path / "local.zarr"))
 

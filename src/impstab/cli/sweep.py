@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from pathlib import Path
@@ -39,30 +40,43 @@ def _fmt(v, unit: str = "") -> str:
 @click.option("--export", "exports", multiple=True, type=click.Path(dir_okay=False),
               help="also write the results to FILE.nc (netCDF) or FILE.csv; may be repeated")
 @click.option("--progress/--no-progress", default=None, help="progress bar (default: when the terminal shows one)")
+@click.option("--min-dask-designs", type=int, default=None,
+              help="fewer designs to compute (or fewer than 2 chunks per worker) run in process even with "
+                   "--workers/--scheduler; default 20000, 0: always on Dask")
 def sweep_cmd(study_file: str, store: str | None, workers: int | None, scheduler: str | None,
-              exports: tuple[str, ...], progress: bool | None) -> None:
+              exports: tuple[str, ...], progress: bool | None, min_dask_designs: int | None) -> None:
     """Run the design study STUDY_FILE (or resume it) into a zarr store."""
+    from ..io import check_output
     from ..studies import load_study, run_study
+    from ..studies.execute import IN_PROCESS_BELOW, MAX_WORKERS
 
     if workers is not None and scheduler is not None:
         raise ModelError("--workers", workers, "give either --workers or --scheduler, not both")
-    if workers is not None and workers < 1:
-        raise ModelError("--workers", workers, "must be >= 1")
+    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+        raise ModelError("--workers", workers, f"must be from 1 to {MAX_WORKERS}")
+    if min_dask_designs is not None and min_dask_designs < 0:
+        raise ModelError("--min-dask-designs", min_dask_designs, "must be >= 0")
     for path in exports:
         if Path(path).suffix.lower() not in _EXPORTS:
             raise ModelError("--export", path, "must end in .nc (netCDF) or .csv")
     study = load_study(study_file)
     out = Path(store) if store else Path(Path(study_file).stem + ".zarr")
+    for path in exports:
+        check_output(path, option="--export")  # before the run, not after it
     if progress is None:
         progress = sys.stderr.isatty()
     t0 = time.perf_counter()
     try:
-        res = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress)
+        res = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress,
+                        report=lambda line: click.echo(f"impstab: note: {line}", err=True),
+                        in_process_below=IN_PROCESS_BELOW if min_dask_designs is None else min_dask_designs)
     except KeyboardInterrupt:
+        if not out.exists():
+            raise Interrupted("interrupted before the first chunk was finished; nothing was kept") from None
         raise Interrupted(f"interrupted; the chunks finished so far are kept in {out}: "
                           "run the same command again to resume") from None
     elapsed = time.perf_counter() - t0
-    written = [str(res.export(p)) for p in exports]
+    written = [str(res.export(p, option="--export")) for p in exports]
     _summary(res, study, out, elapsed, written)
 
 
@@ -76,6 +90,9 @@ def _summary(res, study, out: Path, elapsed: float, written: list[str]) -> None:
     t.add_row("parameters", ", ".join(p.name for p in study.parameters))
     t.add_row("designs", ", ".join(f"{k} {v}" for k, v in counts.items() if v or k == "ok"))
     t.add_row("time (this run)", f"{elapsed:.3g} s")
+    history = json.loads(res.dataset.attrs.get("history", "[]"))
+    if history:
+        t.add_row("run", f"{history[-1].get('executor', '')}; {history[-1].get('chunks_computed', 0)} chunks computed")
     if counts["ok"]:
         for by in ("margin", "critical_thrust"):
             if by in res.dataset:
@@ -118,13 +135,20 @@ def _parse_at(items: tuple[str, ...]) -> dict[str, object]:
 @click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), help="PNG file; default STORE-map.png")
 def map_cmd(store: str, x: str | None, y: str | None, value: str, at: tuple[str, ...], output: str | None) -> None:
     """Draw the stability map of the study in STORE to a PNG."""
-    from ..io import atomic_path
+    from ..io import check_output, save_figure
     from ..studies import open_study
 
     out = Path(output) if output else Path(str(Path(store)).rstrip("/\\").removesuffix(".zarr") + "-map.png")
     if out.suffix.lower() != ".png":
         raise ModelError("--output", str(out), "must end in .png")
+    check_output(out, option="--output")
     res = open_study(store)
+    if res.pending_chunks:
+        n = res.dataset.attrs.get("n_chunks", "?")
+        shown = ", ".join(str(i) for i in res.pending_chunks[:8]) + (" ..." if len(res.pending_chunks) > 8 else "")
+        click.echo(f"impstab: warning: {len(res.pending_chunks)} of {n} chunks of {store} are not computed yet "
+                   f"(chunks {shown}): their designs are left blank; run 'impstab sweep' on the study again "
+                   "to finish them", err=True)
     import matplotlib
 
     if matplotlib.get_backend().lower() != "agg":
@@ -132,9 +156,10 @@ def map_cmd(store: str, x: str | None, y: str | None, value: str, at: tuple[str,
     import matplotlib.pyplot as plt
 
     ax = res.plot(x=x, y=y, value=value, at=_parse_at(at))
-    with atomic_path(out) as tmp:
-        ax.figure.savefig(tmp, format="png", dpi=130)
-    plt.close(ax.figure)
+    try:
+        save_figure(ax.figure, out, option="--output", dpi=130)
+    finally:
+        plt.close(ax.figure)
     console().print(f"wrote {out}")
 
 

@@ -1,12 +1,29 @@
-"""The result store: a zarr group that xarray opens as the study's Dataset, written chunk by chunk.
+"""The result store: a zarr group that xarray opens as the study's Dataset, that proves itself complete.
 
-Layout (zarr format 3): one array per output plus ``status`` and ``message``, chunked exactly like
-the study's chunk plan, with one dimension per grid parameter (or ``sample``); coordinate arrays
-for the parameter values; attributes with the study file, the base model, the package version
-and timestamps. A sub-group ``progress`` holds one record per chunk (finish time, number of
-times computed, seconds), written *after* the chunk's data: a chunk is done only when its record
-exists, so a chunk half-written when the process died is simply computed again. zarr writes each
-stored chunk to a temporary file and renames it, so a record is never half-written.
+Layout (zarr format 3, ``impstab-study-store/2``): one array per output plus ``status`` and
+``message``, chunked exactly like the study's chunk plan, with one dimension per grid parameter
+(or ``sample``); coordinate arrays for the parameter values; attributes with the study file,
+the base model, the package version, timestamps and the run history; consolidated metadata in
+the root ``zarr.json``; the sub-group ``progress`` with one completion record per chunk
+(:mod:`impstab.studies.records`) and the size and CRC-32 of every coordinate file; the run lock
+``.impstab-lock`` (:mod:`impstab.studies.lock`).
+
+What proves what:
+
+* **The chunks' data**: a chunk is done when its record exists, and it is trusted only while
+  every file of the chunk has the size and CRC-32 its record gives. The record is written after
+  the data, by the process that wrote them, so a chunk cut short by a kill has no record.
+* **The static part** -- every ``zarr.json`` and the coordinate arrays -- follows from the study
+  alone: a run builds it in memory (:func:`_reference`), and a resume compares the store with it
+  file by file and rewrites what differs. The root ``zarr.json`` also carries the CRC-32 of its
+  own fixed attributes and consolidated metadata (``integrity``), for readers that have no study.
+
+A resume (:meth:`StudyStore.create_or_resume`) takes the lock, refuses a store with a symbolic
+link inside (nothing is ever written outside the store), removes the temporary files of writes
+cut short, repairs the static part, and verifies every chunk: a damaged one (a file missing,
+truncated or corrupt, or its record damaged) is said and computed again. A reader
+(:func:`read_store`) decodes only what it verified: damaged data are refused with the chunks
+named, chunks not computed yet are left at their fill values and named.
 """
 
 from __future__ import annotations
@@ -14,29 +31,49 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import os
+import secrets
 import shutil
 import time
+import zlib
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import ModelError
+from ..io import output_error, owner_tag, remove_stale
 from ..linear.batch import KINDS, STATUSES
 from .evaluate import CODE_OUTPUTS, ChunkResult
+from .lock import RunLock
 from .plan import ChunkPlan
+from .records import Check, check_chunk, columns, decode, encode, file_checksum, record_key
 from .schema import OUTPUTS
+from .store_files import FolderFiles, MemoryFiles, StoreFiles, StoreLinkError, scan
 from .study import Study, describe
 
-__all__ = ["StudyStore", "now_iso", "tidy"]
+__all__ = ["StudyStore", "ChunkWriter", "StoreView", "read_store", "now_iso", "tidy", "chunk_arrays", "data_key",
+           "FORMAT"]
 
-_FORMAT = "impstab-study-store/1"
-_RECORD = ("finished_at", "runs", "seconds", "evaluations")
+FORMAT = "impstab-study-store/2"
+#: root attributes that change from run to run (all others are fixed when the store is made)
+DYNAMIC = ("updated", "completed", "complete", "history")
+_INTEGRITY = "integrity"
 
 
 def now_iso() -> str:
     """The current UTC time, ISO 8601 to the second."""
     return _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
+
+
+def chunk_arrays(outputs) -> tuple[str, ...]:
+    """The arrays each chunk of the store holds: the outputs, ``status`` and ``message``."""
+    return (*outputs, "status", "message")
+
+
+def data_key(name: str, plan: ChunkPlan, index: int) -> str:
+    """The key of chunk ``index``'s file of array ``name``."""
+    pos = np.unravel_index(index, plan.grid)
+    return f"{name}/c/" + "/".join(str(int(p)) for p in pos)
 
 
 def _variable_attrs(name: str) -> dict[str, Any]:
@@ -67,140 +104,13 @@ def _kind(name: str) -> tuple[Any, Any]:
     return "f8", np.nan
 
 
-class StudyStore:
-    """A study's zarr store (open with :meth:`create_or_resume`)."""
-
-    def __init__(self, group, plan: ChunkPlan, path: Path | None) -> None:
-        self.group = group
-        self.plan = plan
-        self.path = path
-        self._arrays: dict = {}  # the result arrays, opened once
-        self._records: np.ndarray | None = None  # the progress records as last read or written
-        self._written: dict[int, dict[str, np.ndarray]] = {}  # chunk data written by this object
-
-    # -- creation and resumption -------------------------------------------------------------
-    @classmethod
-    def create_or_resume(cls, study: Study, plan: ChunkPlan, path: str | os.PathLike[str] | None) -> "StudyStore":
-        """Open the store at ``path`` for ``study``, creating it if it does not exist.
-
-        ``path`` None keeps the store in memory. An existing store must hold the same study
-        (same study file contents and base model) made by the same impstab version.
-        """
-        import zarr
-
-        if path is None:
-            mem = zarr.storage.MemoryStore()
-            _initialise(zarr.open_group(mem, mode="w", zarr_format=3), study, plan)
-            _consolidate(mem)
-            return cls(zarr.open_group(mem, mode="r+", zarr_format=3), plan, None)
-        path = Path(path)
-        if path.exists():
-            group = _open_existing(path, study)
-            _remove_partial_files(path)
-            return cls(group, plan, path)
-        tmp = path.with_name(f".{path.name}.creating-{os.getpid()}")
-        shutil.rmtree(tmp, ignore_errors=True)
-        try:
-            _initialise(zarr.open_group(str(tmp), mode="w-", zarr_format=3), study, plan)
-            _consolidate(str(tmp))
-            os.rename(tmp, path)
-        except BaseException:
-            shutil.rmtree(tmp, ignore_errors=True)
-            raise
-        return cls(zarr.open_group(str(path), mode="r+", zarr_format=3), plan, path)
-
-    # -- progress ----------------------------------------------------------------------------
-    def records(self) -> np.ndarray:
-        """``(n_chunks, 4)`` records: finish time (epoch s, NaN if not done), runs, seconds, evaluations."""
-        self._records = self.group["progress/chunks"][...]
-        return self._records.copy()
-
-    def done(self) -> np.ndarray:
-        """Which chunks are complete."""
-        return np.isfinite(self.records()[:, 0])
-
-    def write(self, result: ChunkResult) -> None:
-        """Write one chunk's data, then its completion record.
-
-        The number of runs of the chunk comes from the records as read at the start (this
-        process is the store's only writer) and kept up to date here.
-        """
-        for name in (*result.data, "progress/chunks"):
-            if name not in self._arrays:
-                self._arrays[name] = self.group[name]
-        sl = self.plan.slices(result.index)
-        for name, arr in result.data.items():
-            self._arrays[name][sl] = arr
-        if self._records is None:
-            self.records()
-        runs = self._records[result.index, 1]
-        runs = 0.0 if not np.isfinite(runs) else float(runs)
-        row = np.array([time.time(), runs + 1.0, result.seconds, float(result.evaluations)])
-        self._arrays["progress/chunks"][result.index, :] = row
-        self._records[result.index] = row
-        self._written[result.index] = result.data
-
-    def begin_run(self, executor: str) -> int:
-        """Record the start of a run in the store's history; returns its position."""
-        history = json.loads(self.group.attrs.get("history", "[]"))
-        history.append({"started": now_iso(), "ended": None, "executor": executor, "chunks_computed": 0})
-        self.group.update_attributes({"history": json.dumps(history), "updated": now_iso()})  # one metadata write
-        return len(history) - 1
-
-    def end_run(self, run: int, computed: int, interrupted: bool = False) -> None:
-        """Close the run's history entry and update the timestamps and the completion flag."""
-        attrs = self.group.attrs
-        history = json.loads(attrs.get("history", "[]"))
-        history[run].update(ended=now_iso(), chunks_computed=computed, interrupted=interrupted)
-        records = self.records() if self._records is None else self._records
-        done = bool(np.isfinite(records[:, 0]).all())
-        new = {"history": json.dumps(history), "updated": now_iso(), "complete": int(done)}
-        if done and not attrs.get("completed"):
-            new["completed"] = now_iso()
-        self.group.update_attributes(new)  # one metadata write
-
-    def open_dataset(self):
-        """The results as an xarray Dataset (lazy, backed by the store)."""
-        import xarray as xr
-
-        store = self.group.store if self.path is None else str(self.path)
-        return tidy(xr.open_zarr(store, consolidated=True, chunks=None))
-
-    def load_dataset(self):
-        """The results as an xarray Dataset in memory.
-
-        When this object wrote every chunk of the study (a run from the start), the result
-        variables are assembled from the chunks it wrote instead of being read back: the same
-        values, without reading every chunk of every variable again (some 0.3 ms each). The
-        attributes, coordinates and dtypes come from the store either way.
-        """
-        ds = self.open_dataset()
-        if len(self._written) == self.plan.n_chunks and all(v in self._written[0] for v in ds.data_vars):
-            full = {}
-            for name in ds.data_vars:
-                arr = np.empty(ds[name].shape, dtype=ds[name].dtype)
-                for index, data in self._written.items():
-                    arr[self.plan.slices(index)] = data[name]
-                full[name] = ds[name].copy(data=arr)
-            ds = ds.assign(full)
-        return ds.load()
-
-
-def tidy(ds):
-    """Parameters as coordinates; outputs in the study file's order, then status and message."""
-    params = json.loads(ds.attrs.get("parameters", "[]"))
-    ds = ds.set_coords([p for p in params if p in ds.data_vars])
-    order = [*json.loads(ds.attrs.get("outputs", "[]")), "status", "message"]
-    return ds[[v for v in order if v in ds.data_vars] + [v for v in ds.data_vars if v not in order]]
-
-
-def _initialise(group, study: Study, plan: ChunkPlan) -> None:
+# -- the static part ------------------------------------------------------------------------------
+def _static_attrs(study: Study, plan: ChunkPlan, created: str) -> dict[str, Any]:
     from .. import __version__
 
-    dims = list(study.dims)
     attrs = {
         "title": f"design study {study.name}",
-        "format": _FORMAT,
+        "format": FORMAT,
         "study_name": study.name,
         "study_file": study.study_text,
         "study_path": study.source or "",
@@ -209,39 +119,80 @@ def _initialise(group, study: Study, plan: ChunkPlan) -> None:
         "model_name": study.model_name,
         "impstab_version": __version__,
         "fingerprint": study.fingerprint,
-        "created": now_iso(),
-        "updated": now_iso(),
-        "completed": "",
-        "complete": 0,
-        "history": "[]",
+        "created": created,
         "chunk_shape": list(plan.chunks),
         "n_chunks": plan.n_chunks,
         "kind_legend": json.dumps(dict(enumerate(KINDS))),
         "status_legend": json.dumps(dict(enumerate(STATUSES))),
     }
     attrs.update({k: (json.dumps(v) if isinstance(v, list) else v) for k, v in describe(study).items()})
-    group.update_attributes(attrs)  # one metadata write (attrs.update writes once per key)
+    return attrs
+
+
+def _fresh_dynamic() -> dict[str, Any]:
+    return {"updated": now_iso(), "completed": "", "complete": 0, "history": "[]"}
+
+
+def _canonical(obj) -> bytes:
+    return json.dumps(obj, sort_keys=True, separators=(",", ":")).encode()
+
+
+def _integrity(static: dict, consolidated) -> int:
+    return zlib.crc32(_canonical({"attributes": {k: v for k, v in static.items() if k != _INTEGRITY},
+                                  "consolidated_metadata": consolidated}))
+
+
+def _root_bytes(reference_root: dict, static: dict, dynamic: dict) -> bytes:
+    doc = dict(reference_root)
+    attrs = {k: v for k, v in static.items() if k != _INTEGRITY}
+    attrs[_INTEGRITY] = _integrity(attrs, doc.get("consolidated_metadata"))
+    attrs.update(dynamic)
+    doc["attributes"] = attrs
+    return json.dumps(doc, indent=2).encode()
+
+
+def _reference(study: Study, plan: ChunkPlan) -> tuple[dict[str, bytes], dict]:
+    """Every file of the static part as the store must hold it, and the root document.
+
+    The root ``zarr.json`` is not among the files: its attributes are composed per run
+    (:func:`_root_bytes`).
+    """
+    import zarr
+
+    store_dict: dict = {}
+    group = zarr.open_group(zarr.storage.MemoryStore(store_dict=store_dict), mode="w", zarr_format=3)
+    dims = list(study.dims)
+    coords = [p.name for p in study.parameters]
     for p in study.parameters:
         vals = p.values
         dtype = str if vals.dtype.kind == "U" else vals.dtype
-        if study.method == "grid":
-            arr = group.create_array(p.name, shape=vals.shape, dtype=dtype, dimension_names=[p.name],
-                                     attributes={"long_name": f"model-file value {p.name}"})
-        else:
-            arr = group.create_array(p.name, shape=vals.shape, dtype=dtype, chunks=plan.chunks,
-                                     dimension_names=dims, attributes={"long_name": f"model-file value {p.name}"})
+        grid = study.method == "grid"
+        arr = group.create_array(p.name, shape=vals.shape, dtype=dtype, chunks=vals.shape if grid else plan.chunks,
+                                 dimension_names=[p.name] if grid else dims,
+                                 attributes={"long_name": f"model-file value {p.name}"})
         arr[...] = vals
     if study.method != "grid":
+        coords.append("sample")
         arr = group.create_array("sample", shape=study.shape, dtype="i8", chunks=plan.chunks, dimension_names=dims)
         arr[...] = np.arange(study.size)
-    for name in (*study.outputs, "status", "message"):
+    arrays = chunk_arrays(study.outputs)
+    for name in arrays:
         dtype, fill = _kind(name)
         group.create_array(name, shape=study.shape, dtype=dtype, chunks=plan.chunks, fill_value=fill,
                            dimension_names=dims, attributes=_variable_attrs(name))
-    prog = group.create_group("progress")
-    prog.create_array("chunks", shape=(plan.n_chunks, len(_RECORD)), dtype="f8", chunks=(1, len(_RECORD)),
-                      fill_value=np.nan, dimension_names=["chunk", "record"],
-                      attributes={"columns": json.dumps(_RECORD), "units": json.dumps(["s since epoch", "1", "s", "1"])})
+    coordinate_files = {k: list(file_checksum(v.to_bytes())) for k, v in store_dict.items()
+                        if k.split("/")[0] in coords and not k.endswith("zarr.json")}
+    cols = columns(arrays)
+    prog = group.create_group("progress", attributes={"fingerprint": study.fingerprint, "arrays": list(arrays),
+                                                      "coordinate_files": coordinate_files})
+    prog.create_array("chunks", shape=(plan.n_chunks, len(cols)), dtype="f8", chunks=(1, len(cols)),
+                      fill_value=np.nan, compressors=None, dimension_names=["chunk", "record"],
+                      attributes={"columns": list(cols),
+                                  "comment": "one completion record per chunk: see impstab.studies.records"})
+    _consolidate(group.store)
+    files = {k: v.to_bytes() for k, v in store_dict.items()}
+    root = json.loads(files.pop("zarr.json"))
+    return files, root
 
 
 def _consolidate(store) -> None:
@@ -255,37 +206,532 @@ def _consolidate(store) -> None:
         zarr.consolidate_metadata(store)
 
 
-def _open_existing(path: Path, study: Study):
-    import zarr
+def _json(data: bytes | None):
+    if data is None:
+        return None
+    try:
+        doc = json.loads(data)
+    except (ValueError, UnicodeDecodeError):
+        return None
+    return doc if isinstance(doc, dict) else None
 
+
+def _attrs(doc) -> dict:
+    attrs = doc.get("attributes") if isinstance(doc, dict) else None
+    return attrs if isinstance(attrs, dict) else {}
+
+
+def _root_intact(doc) -> bool:
+    attrs = _attrs(doc)
+    static = {k: v for k, v in attrs.items() if k not in DYNAMIC}
+    return _INTEGRITY in attrs and attrs[_INTEGRITY] == _integrity(static, doc.get("consolidated_metadata"))
+
+
+def _same(key: str, disk: bytes | None, ref: bytes) -> bool:
+    if disk is None:
+        return False
+    if key.endswith("zarr.json"):
+        return _json(disk) is not None and _json(disk) == _json(ref)
+    return disk == ref
+
+
+def _history(text) -> list | None:
+    try:
+        history = json.loads(text) if isinstance(text, str) else None
+    except ValueError:
+        return None
+    return history if isinstance(history, list) and all(isinstance(h, dict) for h in history) else None
+
+
+def _names(items: list[str], limit: int = 6) -> str:
+    shown = ", ".join(items[:limit])
+    return shown + (f" and {len(items) - limit} more" if len(items) > limit else "")
+
+
+def _count(n: int, what: str) -> str:
+    return f"{n} {what}" + ("" if n == 1 else "s")
+
+
+def _stale_note(p: Path) -> str:
+    return f"removed {p.name}, left by a run that was killed while it made the store"
+
+
+# -- writing chunks -------------------------------------------------------------------------------
+class ChunkWriter:
+    """Writes a chunk's data, then its completion record (in the client or on a Dask worker).
+
+    Parameters
+    ----------
+    files : StoreFiles
+        The store's files (symbolic links are refused before each write).
+    zarr_store : zarr store
+        The same store for zarr (a folder path or the in-memory store).
+    plan : ChunkPlan
+    arrays : tuple of str
+        The arrays of a chunk (:func:`chunk_arrays`).
+    """
+
+    def __init__(self, files: StoreFiles, zarr_store, plan: ChunkPlan, arrays: tuple[str, ...]) -> None:
+        import zarr
+
+        self.files = files
+        self.plan = plan
+        self.arrays = arrays
+        group = zarr.open_group(zarr_store, mode="r+", zarr_format=3)
+        # every chunk file is written, also one of fill values only: a file that is not there is missing
+        self._zarr = {n: group[n].with_config({"write_empty_chunks": True}) for n in arrays}
+
+    def write(self, result: ChunkResult, runs: int) -> np.ndarray:
+        """Write ``result`` (computed for the ``runs``-th time); return its record (all columns)."""
+        index = result.index
+        keys = [data_key(n, self.plan, index) for n in self.arrays]
+        for key in (*keys, record_key(index)):
+            self.files.check(key)
+        self.files.remove(record_key(index))  # a chunk computed again is not done until its new record
+        sl = self.plan.slices(index)
+        for name in self.arrays:
+            self._zarr[name][sl] = result.data[name]
+        sums = [v for key in keys for v in file_checksum(self.files.read(key))]
+        fields = np.array([time.time(), float(runs), result.seconds, float(result.evaluations), float(index), *sums],
+                          dtype=np.float64)
+        self.files.write(record_key(index), encode(fields))
+        return np.append(fields, np.nan)
+
+
+# -- the store ------------------------------------------------------------------------------------
+class StudyStore:
+    """A study's zarr store, open for a run (from :meth:`create_or_resume`; :meth:`close` when done).
+
+    Attributes
+    ----------
+    path : Path or None
+        The store folder (None: in memory).
+    findings : list of str
+        What opening it found and did, one line each (repairs, chunks to compute again, stale
+        temporaries removed).
+    created : bool
+        Whether this run made the store.
+    recomputed : list of int
+        The chunks found damaged (computed again by this run).
+    repaired : list of str
+        The metadata and coordinate files rewritten from the study.
+    """
+
+    def __init__(self, study: Study, plan: ChunkPlan, files: StoreFiles, zarr_store, path: Path | None,
+                 root: dict, static: dict, dynamic: dict, lock: RunLock | None, created: bool) -> None:
+        self.study = study
+        self.plan = plan
+        self.files = files
+        self.zarr_store = zarr_store
+        self.path = path
+        self.arrays = chunk_arrays(study.outputs)
+        self._root = root
+        self._static = static
+        self._dynamic = dynamic
+        self.lock = lock
+        self.created = created
+        self.findings: list[str] = []
+        self.recomputed: list[int] = []
+        self.repaired: list[str] = []
+        self._records = np.full((plan.n_chunks, len(columns(self.arrays))), np.nan)
+        self._done = np.zeros(plan.n_chunks, dtype=bool)
+        self._runs = np.zeros(plan.n_chunks, dtype=int)
+        self._writer: ChunkWriter | None = None
+        self._written: dict[int, dict[str, np.ndarray]] = {}
+        self.run_id = ""
+
+    # -- opening --------------------------------------------------------------------------------
+    @classmethod
+    def create_or_resume(cls, study: Study, plan: ChunkPlan, path: str | os.PathLike[str] | None,
+                         field: str = "--output") -> "StudyStore":
+        """Open the store at ``path`` for ``study`` (creating it if it does not exist) and lock it.
+
+        ``path`` None keeps the store in memory. An existing store must hold the same study
+        (same study file contents and base model), made by the same impstab version; it is
+        verified and repaired (module docstring) before anything is computed.
+
+        Raises
+        ------
+        ModelError
+            Not a store of this study, another run writes it, a symbolic link inside it, or it
+            cannot be written (:class:`impstab.io.OutputError`).
+        """
+        files_ref, root = _reference(study, plan)
+        if path is None:
+            import zarr
+
+            store_dict: dict = {}
+            files = MemoryFiles(store_dict)
+            for key, data in files_ref.items():
+                files.write(key, data)
+            static, dynamic = _static_attrs(study, plan, now_iso()), _fresh_dynamic()
+            files.write("zarr.json", _root_bytes(root, static, dynamic))
+            return cls(study, plan, files, zarr.storage.MemoryStore(store_dict=store_dict), None, root, static,
+                       dynamic, None, True)
+        path = Path(path)
+        if not path.exists() and not path.is_symlink():
+            made = cls._create(study, plan, path, field, files_ref, root)
+            if made is not None:
+                return made
+        return cls._resume(study, plan, path, field, files_ref, root)
+
+    @classmethod
+    def _create(cls, study, plan, path: Path, field: str, files_ref: dict, root: dict) -> "StudyStore | None":
+        """Make the store in a temporary folder beside ``path`` and rename it; None if another run made it first."""
+        parent = path.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise output_error(field, path, exc) from None
+        found = [_stale_note(p) for p in remove_stale(parent, f".{path.name}.creating-")]
+        tmp = parent / f".{path.name}.creating-{owner_tag()}"
+        lock = None
+        try:
+            tmp.mkdir()
+            lock = RunLock(tmp, field).acquire()
+            files = FolderFiles(tmp, field)
+            for key, data in files_ref.items():
+                files.write(key, data)
+            static, dynamic = _static_attrs(study, plan, now_iso()), _fresh_dynamic()
+            files.write("zarr.json", _root_bytes(root, static, dynamic))
+            try:
+                os.rename(tmp, path)
+            except OSError:
+                if not path.exists():
+                    raise
+                lock.release()
+                shutil.rmtree(tmp, ignore_errors=True)
+                return None  # made by another run in the meantime: resume it
+        except BaseException as exc:
+            if lock is not None:
+                lock.release()
+            shutil.rmtree(tmp, ignore_errors=True)
+            if isinstance(exc, OSError):
+                raise output_error(field, path, exc) from None
+            raise
+        lock.root = path
+        store = cls(study, plan, FolderFiles(path, field), str(path), path, root, static, dynamic, lock, True)
+        store.findings = found
+        return store
+
+    @classmethod
+    def _resume(cls, study, plan, path: Path, field: str, files_ref: dict, root: dict) -> "StudyStore":
+        if not path.is_dir():
+            raise ModelError(field, str(path), "exists and is not an impstab study store (give a new path)")
+        files = FolderFiles(path, field)
+        findings = [_stale_note(p) for p in remove_stale(path.parent, f".{path.name}.creating-")]
+        try:
+            disk_root = _json(files.read("zarr.json"))
+            progress = _json(files.read("progress/zarr.json"))
+        except OSError as exc:
+            raise ModelError(field, str(path), f"cannot be read: {exc.strerror or exc}") from None
+        intact = disk_root is not None and _root_intact(disk_root)
+        _identify(study, path, field, disk_root, intact, progress)
+        lock = RunLock(path, field).acquire()
+        try:
+            links, partial = scan(path)
+            if links:
+                raise StoreLinkError(field, str(path), str(links[0]))
+            for p in partial:
+                try:
+                    p.unlink()
+                except OSError:
+                    pass
+            repaired = [key for key, data in files_ref.items() if not _same(key, files.read(key), data)]
+            for key in repaired:
+                files.write(key, files_ref[key])
+            attrs = _attrs(disk_root)
+            created = attrs.get("created") if isinstance(attrs.get("created"), str) else now_iso()
+            static = ({k: v for k, v in attrs.items() if k not in DYNAMIC} if intact
+                      else _static_attrs(study, plan, created))
+            dynamic = _fresh_dynamic()
+            history = _history(attrs.get("history"))
+            if history is not None:
+                dynamic.update({k: attrs[k] for k in DYNAMIC if k in attrs and k != "history"})
+                dynamic["history"] = json.dumps(history)
+            root_now = _root_bytes(root, static, dynamic)
+            if not intact or _json(root_now) != disk_root:
+                repaired.insert(0, "zarr.json" + ("" if history is not None else " (its run history was lost)"))
+                files.write("zarr.json", root_now)
+            store = cls(study, plan, files, str(path), path, root, static, dynamic, lock, False)
+            store._verify()
+        except OSError as exc:
+            lock.release()
+            raise output_error(field, path, exc, "nothing was computed") from None
+        except BaseException:
+            lock.release()
+            raise
+        if partial:
+            findings.append(f"removed {_count(len(partial), 'temporary file')} of writes cut short")
+        if repaired:
+            findings.append(f"repaired {_count(len(repaired), 'metadata or coordinate file')} from the study: "
+                            f"{_names(repaired)}")
+        store.findings = findings + store.findings
+        store.repaired = repaired
+        return store
+
+    def _verify(self) -> None:
+        """Check every chunk against its record; a damaged chunk loses its record (computed again)."""
+        damaged = []
+        n_columns = len(columns(self.arrays))
+        for i in range(self.plan.n_chunks):
+            record = self.files.read(record_key(i))
+            check = check_chunk(i, record, self.arrays, [data_key(n, self.plan, i) for n in self.arrays],
+                                self.files.read)
+            row = decode(record, n_columns)
+            self._runs[i] = int(row[1]) if row is not None else (1 if record is not None else 0)
+            self._done[i] = check.state == "done"
+            if check.state == "damaged":
+                damaged.append(check)
+                self.files.remove(record_key(i))
+        self.recomputed = [c.index for c in damaged]
+        if damaged:
+            self.findings.append(f"computing {_count(len(damaged), 'chunk')} again, whose stored data do not match "
+                                 "the completion record: " + _names([c.describe() for c in damaged]))
+
+    # -- progress ---------------------------------------------------------------------------------
+    def todo(self) -> list[int]:
+        """The chunks to compute: those not done (never computed, cut short, or damaged)."""
+        return [int(i) for i in np.flatnonzero(~self._done)]
+
+    def done(self) -> np.ndarray:
+        """Which chunks are complete (verified when opened, or written by this run)."""
+        return self._done.copy()
+
+    def previous_runs(self, index: int) -> int:
+        """How often chunk ``index`` had been computed when the store was opened (at least 1 if damaged)."""
+        return int(self._runs[index])
+
+    @property
+    def writer(self) -> ChunkWriter:
+        if self._writer is None:
+            self._writer = ChunkWriter(self.files, self.zarr_store, self.plan, self.arrays)
+        return self._writer
+
+    def write(self, result: ChunkResult) -> None:
+        """Write one chunk's data, then its completion record (in this process)."""
+        self.mark_done(result.index, self.writer.write(result, self.previous_runs(result.index) + 1))
+        self._written[result.index] = result.data
+
+    def mark_done(self, index: int, record: np.ndarray) -> None:
+        """Note a chunk written (here, or by a worker, which sends its record)."""
+        self._records[index] = record
+        self._done[index] = True
+
+    def records(self) -> np.ndarray:
+        """The records written by this run (NaN rows for the others)."""
+        return self._records.copy()
+
+    # -- the run history --------------------------------------------------------------------------
+    def _write_root(self) -> None:
+        self.files.write("zarr.json", _root_bytes(self._root, self._static, self._dynamic))
+
+    def begin_run(self, executor: str) -> int:
+        """Record the start of a run in the store's history; returns its position."""
+        history = json.loads(self._dynamic["history"])
+        self.run_id = secrets.token_hex(8)
+        entry: dict[str, Any] = {"started": now_iso(), "ended": None, "executor": executor, "chunks_computed": 0,
+                                 "run": self.run_id}
+        if self.recomputed:
+            entry["recomputed"] = self.recomputed
+        if self.repaired:
+            entry["repaired"] = self.repaired
+        history.append(entry)
+        self._dynamic.update(history=json.dumps(history), updated=now_iso())
+        self._write_root()
+        return len(history) - 1
+
+    def set_executor(self, run: int, executor: str) -> None:
+        """Describe where run ``run`` computed (written with the run's end)."""
+        history = json.loads(self._dynamic["history"])
+        history[run]["executor"] = executor
+        self._dynamic["history"] = json.dumps(history)
+
+    def end_run(self, run: int, computed: int, interrupted: bool = False, error: str | None = None) -> None:
+        """Close the run's history entry; update the timestamps and the completion flag."""
+        history = json.loads(self._dynamic["history"])
+        history[run].update(ended=now_iso(), chunks_computed=computed, interrupted=interrupted)
+        if error:
+            history[run]["error"] = error
+        done = bool(self._done.all())
+        self._dynamic.update(history=json.dumps(history), updated=now_iso(), complete=int(done))
+        if done and not self._dynamic.get("completed"):
+            self._dynamic["completed"] = now_iso()
+        self._write_root()
+
+    # -- reading ----------------------------------------------------------------------------------
+    def open_dataset(self):
+        """The verified results as an xarray Dataset in memory (see :func:`read_store`)."""
+        return read_store(self.files, str(self.path or "memory"), field="--output").dataset
+
+    def load_dataset(self):
+        """The results as an xarray Dataset in memory.
+
+        When this object wrote every chunk of the study (a run from the start), the result
+        variables are assembled from the chunks it wrote instead of being read back: the same
+        values, without decoding every chunk again. The attributes, coordinates and dtypes come
+        from the store either way.
+        """
+        if len(self._written) != self.plan.n_chunks:
+            return self.open_dataset()
+        ds = read_store(self.files, str(self.path or "memory"), field="--output", data=False).dataset
+        full = {}
+        for name in ds.data_vars:
+            arr = np.empty(ds[name].shape, dtype=ds[name].dtype)
+            for index, data in self._written.items():
+                arr[self.plan.slices(index)] = data[name]
+            full[name] = ds[name].copy(data=arr)
+        return ds.assign(full)
+
+    # -- closing ----------------------------------------------------------------------------------
+    def close(self) -> None:
+        """Release the run lock."""
+        if self.lock is not None:
+            self.lock.release()
+
+    def discard(self) -> bool:
+        """Remove the store if this run made it and finished no chunk in it (nothing to resume)."""
+        self.close()
+        if self.created and self.path is not None and not self._done.any():
+            shutil.rmtree(self.path, ignore_errors=True)
+            return True
+        return False
+
+    def __enter__(self) -> "StudyStore":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def _identify(study: Study, path: Path, field: str, root, intact: bool, progress) -> None:
+    """Refuse anything but a store of this study made by this version (damaged metadata of one is fine)."""
     from .. import __version__
 
+    attrs = _attrs(root)
+    fmt = attrs.get("format")
+    if intact:
+        if fmt != FORMAT:
+            raise ModelError(field, str(path), "exists and is not an impstab study store (give a new path)")
+        if attrs.get("fingerprint") != study.fingerprint:
+            raise ModelError(field, str(path),
+                             "holds a different study (the study file or its base model changed since it was "
+                             "started): give a new path or remove it")
+        if attrs.get("impstab_version") != __version__:
+            raise ModelError(field, str(path),
+                             f"was started with impstab {attrs.get('impstab_version')}, this is {__version__}: "
+                             "finish it with that version or start a new store")
+        return
+    if isinstance(fmt, str) and fmt.startswith("impstab-study-store/") and fmt != FORMAT and _INTEGRITY not in attrs:
+        raise ModelError(field, str(path), f"was written in an older store format ({fmt}, without checksums): "
+                                           "finish it with the impstab version that started it, or start a new store")
+    if attrs.get("fingerprint") == study.fingerprint or _attrs(progress).get("fingerprint") == study.fingerprint:
+        return  # ours, with damaged metadata: repaired from the study
+    if root is None and progress is None:
+        raise ModelError(field, str(path), "exists and is not an impstab study store (give a new path)")
+    raise ModelError(field, str(path), "exists, but its metadata are damaged and do not name this study: "
+                                       "give a new path, or remove it to start again")
+
+
+# -- reading --------------------------------------------------------------------------------------
+class StoreView:
+    """What :func:`read_store` found: the dataset, and the chunks not computed yet."""
+
+    def __init__(self, dataset, pending: list[int], n_chunks: int) -> None:
+        self.dataset = dataset
+        self.pending = pending
+        self.n_chunks = n_chunks
+
+
+def read_store(files: StoreFiles, name: str, field: str = "STORE", data: bool = True) -> StoreView:
+    """Read a store, decoding only what is verified.
+
+    The root metadata must match their CRC-32, every coordinate file the size and CRC-32 noted
+    when the store was made, and every chunk with a completion record the sizes and CRC-32s
+    of its record. Chunks without a record are not computed yet: their designs keep the fill
+    values (status -1), whatever files they may hold. The verified files are decoded by zarr
+    from memory, so nothing unverified ever reaches a decoder.
+
+    Parameters
+    ----------
+    files : StoreFiles
+    name : str
+        The store's name in messages.
+    field : str
+        How it was given (``STORE``, ``--output``).
+    data : bool
+        False: the chunks' data are left out (coordinates and attributes only).
+
+    Raises
+    ------
+    ModelError
+        Not a study store, damaged metadata, or damaged chunks (named).
+    """
+    import xarray as xr
+    import zarr
+    from zarr.buffer import default_buffer_prototype
+
     try:
-        group = zarr.open_group(str(path), mode="r+", zarr_format=3)
-        attrs = dict(group.attrs)
-    except Exception:  # noqa: BLE001 - any unreadable folder is "not a store"
-        attrs = {}
-    if attrs.get("format") != _FORMAT:
-        raise ModelError("--output", str(path), "exists and is not an impstab study store (give a new path)")
-    if attrs.get("fingerprint") != study.fingerprint:
-        raise ModelError(
-            "--output", str(path),
-            "holds a different study (the study file or its base model changed since it was started): "
-            "give a new path or remove it",
-        )
-    if attrs.get("impstab_version") != __version__:
-        raise ModelError(
-            "--output", str(path),
-            f"was started with impstab {attrs.get('impstab_version')}, this is {__version__}: "
-            "finish it with that version or start a new store",
-        )
-    return group
+        root_bytes = files.read("zarr.json")
+    except OSError as exc:
+        raise ModelError(field, name, f"cannot be read: {exc.strerror or exc}") from None
+    root = _json(root_bytes)
+    attrs = _attrs(root)
+    fmt = attrs.get("format")
+    if not (isinstance(fmt, str) and fmt.startswith("impstab-study-store")):
+        if root_bytes is not None and "consolidated_metadata" not in (root or {}):
+            raise ModelError(field, name, "its metadata (zarr.json) are damaged or it is not an impstab study store: "
+                                          "if it is one, run the study again (impstab sweep STUDY -o STORE) to repair it")
+        raise ModelError(field, name, "is not an impstab study store")
+    if fmt != FORMAT:
+        raise ModelError(field, name, f"was written in an older store format ({fmt}) that cannot be verified: "
+                                      "read it with the impstab version that made it")
+    if not _root_intact(root):
+        raise ModelError(field, name, "its metadata (zarr.json) do not match their checksum: run the study again "
+                                      "(impstab sweep STUDY -o STORE) to repair them")
+    meta = root["consolidated_metadata"]["metadata"]
+    prog = meta["progress"]["attributes"]
+    arrays = tuple(prog["arrays"])
+    plan = ChunkPlan(tuple(json.loads(attrs["shape"])), tuple(attrs["chunk_shape"]))
+    view: dict = {"zarr.json": root_bytes}
+    damaged: list[str] = []
+    pending: list[int] = []
+    try:
+        for key, (size, crc) in prog["coordinate_files"].items():
+            got = files.read(key)
+            if file_checksum(got) != (size, crc):
+                damaged.append(f"coordinate file {key} " + ("missing" if got is None else "damaged"))
+            view[key] = got
+        for i in range(plan.n_chunks if data else 0):
+            got: dict = {}
+
+            def read(key, got=got):
+                got[key] = files.read(key)
+                return got[key]
+
+            check = check_chunk(i, files.read(record_key(i)), arrays, [data_key(n, plan, i) for n in arrays], read)
+            if check.state == "pending":
+                pending.append(i)
+            elif check.state == "damaged":
+                damaged.append(check.describe())
+            else:
+                view.update(got)
+    except OSError as exc:
+        raise ModelError(field, name, f"cannot be read: {exc.strerror or exc}") from None
+    if damaged:
+        raise ModelError(field, name, f"holds damaged data ({_count(len(damaged), 'part')} do not match their "
+                                      f"checksums): {_names(damaged)}; run the study again (impstab sweep STUDY "
+                                      "-o STORE) to compute them again")
+    proto = default_buffer_prototype().buffer
+    mem = zarr.storage.MemoryStore(store_dict={k: proto.from_bytes(v) for k, v in view.items() if v is not None})
+    ds = tidy(xr.open_zarr(mem, consolidated=True, chunks=None)).load()
+    return StoreView(ds, pending, plan.n_chunks)
 
 
-def _remove_partial_files(path: Path) -> None:
-    """Temporary files of writes cut short by a killed process (zarr writes then renames)."""
-    for p in path.rglob("*.partial"):
-        try:
-            p.unlink()
-        except OSError:
-            pass
+def tidy(ds):
+    """Parameters as coordinates; outputs in the study file's order, then status and message."""
+    params = json.loads(ds.attrs.get("parameters", "[]"))
+    ds = ds.set_coords([p for p in params if p in ds.data_vars])
+    ds.attrs.pop(_INTEGRITY, None)
+    order = [*json.loads(ds.attrs.get("outputs", "[]")), "status", "message"]
+    return ds[[v for v in order if v in ds.data_vars] + [v for v in ds.data_vars if v not in order]]

@@ -1,0 +1,307 @@
+"""Studies on ``dask.distributed``: the workers compute and write their own chunks; this process schedules.
+
+**Write path.** Each task computes one chunk and then, on its worker, writes the chunk's arrays
+into the store (region writes: a chunk is exactly one zarr chunk of every array, so no two
+tasks ever write the same file) followed by the chunk's completion record, with the same
+:class:`~impstab.studies.store.ChunkWriter` an in-process run uses. The task returns only the
+record (a few hundred bytes), which this process notes; it reads the store once, verified, at
+the end. A worker killed while it writes leaves a chunk without a record: Dask gives the task to
+another worker, which writes it whole, and a rerun after a killed client computes it again.
+Before the first task, every worker shows that it sees this run's store (its study and the run's
+id in the history); where one does not (a cluster without a shared file system), the workers
+send the chunks' data back and this process writes them.
+
+**Hygiene.** Local worker processes ignore SIGINT, so a Ctrl-C in the terminal reaches only this
+process, which cancels the tasks and shuts the cluster down without Dask's log lines; a
+scheduler address that does not answer is refused before anything is written.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import signal
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..errors import ModelError
+from .evaluate import ChunkTask, evaluate_chunk
+from .plan import ChunkPlan
+
+__all__ = ["local_cluster", "connect", "start_local", "run_on_dask", "Session", "StoreTarget", "run_chunk",
+           "CONNECT_TIMEOUT"]
+
+#: seconds to wait for a scheduler to answer
+CONNECT_TIMEOUT = 10
+
+#: Dask settings of the clusters started here (see :func:`local_cluster`)
+_QUIET_CLUSTER = {
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "2s",
+}
+_LOGGERS = ("distributed", "tornado", "asyncio", "bokeh")
+
+
+@contextlib.contextmanager
+def _silent():
+    """Dask's loggers off, and SIGINT ignored in this (main) thread, while a cluster is torn down."""
+    levels = {n: logging.getLogger(n).level for n in _LOGGERS}
+    for n in _LOGGERS:
+        logging.getLogger(n).setLevel(logging.CRITICAL + 1)
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        yield
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
+        for n, level in levels.items():
+            logging.getLogger(n).setLevel(level)
+
+
+def _ignore_interrupt() -> None:
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _interrupt_plugin():
+    from distributed import WorkerPlugin
+
+    class IgnoreInterrupt(WorkerPlugin):
+        """Worker processes of a local cluster leave Ctrl-C to their client."""
+
+        name = "impstab-ignore-sigint"
+
+        def setup(self, worker) -> None:
+            _ignore_interrupt()
+
+    return IgnoreInterrupt()
+
+
+def local_cluster(n_workers: int, **kwargs):
+    """A ``dask.distributed.LocalCluster`` of single-threaded worker processes for studies.
+
+    Dask's nannies start workers with ``MALLOC_TRIM_THRESHOLD_=65536``; setting it turns off
+    glibc's adaptive mmap threshold, so that every temporary array above 128 kB is mapped and
+    unmapped anew and its pages faulted in again: a chunk of designs then takes 1.5x as long.
+    The workers started here go without it (the batched engine's temporaries are freed at the
+    end of each chunk). They also go without Dask's background work that a study does not
+    use: the statistical profiler that samples each worker's thread every 10 ms (some 4 % of
+    a worker's time), the 20 ms event-loop tick (it only warns of a blocked loop) and the
+    0.5 s system monitor (the dashboard's CPU and memory plots, every 2 s here). On two cores
+    that background took a tenth of a core. The worker processes ignore SIGINT (Ctrl-C is the
+    client's to handle). Other keyword arguments go to ``LocalCluster``.
+    """
+    import dask
+    from distributed import LocalCluster
+
+    kw = dict(threads_per_worker=1, processes=True, silence_logs=logging.ERROR)
+    kw.update(kwargs)
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None  # inherited by the workers
+    try:
+        with dask.config.set(_QUIET_CLUSTER):
+            cluster = LocalCluster(n_workers=n_workers, **kw)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
+    return cluster
+
+
+class Session:
+    """A Dask client and what was started for it (closed quietly by :meth:`close`)."""
+
+    def __init__(self, client, owned: list) -> None:
+        self.client = client
+        self.owned = owned
+
+    def close(self) -> None:
+        with _silent():
+            for obj in self.owned:
+                with contextlib.suppress(Exception):
+                    obj.close()
+        self.owned = []
+
+
+def connect(address: str) -> Session:
+    """A client of the scheduler at ``address``; a one-line ModelError if none answers there."""
+    from distributed import Client
+
+    text = str(address).strip()
+    if not text or any(c.isspace() for c in text):
+        raise ModelError("--scheduler", address, "must be a Dask scheduler address such as tcp://10.0.0.5:8786")
+    try:
+        with _silent():
+            client = Client(text, timeout=f"{CONNECT_TIMEOUT}s")
+    except Exception as exc:  # noqa: BLE001 - any failure to connect is reported in one line
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ModelError("--scheduler", address, f"no Dask scheduler answered there within {CONNECT_TIMEOUT} s "
+                                                 f"({reason[:160]})") from None
+    return Session(client, [client])
+
+
+def start_local(workers: int) -> Session:
+    """A local cluster of ``workers`` processes and its client."""
+    from distributed import Client
+
+    try:
+        import bokeh  # noqa: F401
+
+        dashboard = ":0"
+    except ImportError:
+        dashboard = None
+    with _silent():
+        cluster = local_cluster(workers, dashboard_address=dashboard)
+        client = Client(cluster)
+        with contextlib.suppress(Exception):
+            client.register_plugin(_interrupt_plugin())  # also workers that a nanny restarts
+    return Session(client, [client, cluster])
+
+
+# -- the tasks ------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class StoreTarget:
+    """Where the workers write: the store folder, its study, this run, the chunk layout."""
+
+    path: str
+    fingerprint: str
+    run_id: str
+    plan: ChunkPlan
+    arrays: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class ChunkDone:
+    """A chunk a worker wrote: its number and its completion record."""
+
+    index: int
+    record: np.ndarray
+
+
+_WRITERS: dict = {}
+
+
+def _store_is_this_run(target: StoreTarget) -> bool:
+    import json
+
+    from .store import _attrs, _json
+    from .store_files import FolderFiles
+
+    attrs = _attrs(_json(FolderFiles(Path(target.path)).read("zarr.json")))
+    try:
+        history = json.loads(attrs.get("history", "[]"))
+    except ValueError:
+        return False
+    return attrs.get("fingerprint") == target.fingerprint and bool(history) and history[-1].get("run") == target.run_id
+
+
+def sees_store(target: StoreTarget) -> bool:
+    """Whether this worker sees the store of this run (run on every worker before the first task)."""
+    try:
+        return _store_is_this_run(target)
+    except Exception:  # noqa: BLE001 - cannot see it
+        return False
+
+
+def _writer(target: StoreTarget):
+    from .store import ChunkWriter
+    from .store_files import FolderFiles
+
+    key = (target.path, target.run_id)
+    writer = _WRITERS.get(key)
+    if writer is None:
+        if not _store_is_this_run(target):
+            raise ModelError("--output", target.path, "is not the store of this run on this worker "
+                                                      "(the workers need the store on a shared file system)")
+        _WRITERS.clear()
+        writer = _WRITERS[key] = ChunkWriter(FolderFiles(Path(target.path)), target.path, target.plan, target.arrays)
+    return writer
+
+
+def run_chunk(task: ChunkTask, target: StoreTarget | None, runs: int):
+    """One task: compute the chunk; with a ``target``, write it there and return its record."""
+    result = evaluate_chunk(task)
+    if target is None:
+        return result
+    return ChunkDone(task.index, _writer(target).write(result, runs))
+
+
+def _worker_version() -> str:
+    try:
+        from impstab import __version__
+
+        return __version__
+    except Exception as exc:  # noqa: BLE001 - reported to the user
+        return f"cannot import impstab ({type(exc).__name__}: {exc})"
+
+
+def run_on_dask(client, st, study, plan: ChunkPlan, todo: list[int], done: Callable[[int], None],
+                progress: bool) -> str:
+    """Compute the chunks ``todo`` of the open store ``st`` on ``client``'s cluster; say who wrote them."""
+    from distributed import as_completed
+
+    from .. import __version__
+    from .execute import chunk_task
+
+    for worker, version in client.run(_worker_version).items():
+        if version != __version__:
+            raise ModelError("--scheduler", worker, f"this worker has impstab {version}, the client {__version__}: "
+                                                    "install the same version everywhere")
+    target = None
+    how = "this process keeps the results in memory"
+    if st.path is not None:
+        target = StoreTarget(str(Path(st.path).resolve()), study.fingerprint, st.run_id, plan, st.arrays)
+        seen = client.run(sees_store, target)
+        if seen and all(seen.values()):
+            how = "the workers write the chunks"
+        else:
+            target = None
+            how = "this process writes the chunks: the workers cannot see the store folder"
+    prefix = f"impstab-chunk-{study.fingerprint[:12]}-{st.run_id}"
+    futures = [client.submit(run_chunk, chunk_task(study, plan, i), target, st.previous_runs(i) + 1,
+                             key=f"{prefix}-{i}", pure=False, retries=2) for i in todo]
+    bar = _dask_progress(client, futures) if progress else None
+    pending = as_completed(futures)
+    held: list = []
+    try:
+        for fut in pending:
+            out = fut.result()
+            if isinstance(out, ChunkDone):
+                st.mark_done(out.index, out.record)
+            else:
+                st.write(out)
+            done(int(out.index))
+            # results are released once noted, after Dask's bar has seen every task
+            held.append(fut)
+            if bar is None or hasattr(bar, "_last_response"):
+                for f in held:
+                    f.release()
+                held.clear()
+    except BaseException:
+        with _silent(), contextlib.suppress(Exception):
+            client.cancel(futures)
+        raise
+    return how
+
+
+def _dask_progress(client, futures: list):
+    """Dask's own progress bar: a text bar in a terminal, a widget in a notebook."""
+    from distributed.diagnostics.progressbar import TextProgressBar
+    from distributed.utils import is_kernel
+
+    if is_kernel():
+        from distributed import progress
+        from IPython.display import display
+
+        widget = progress(futures, notebook=True)
+        display(widget)
+        return widget
+    bar = TextProgressBar(futures, scheduler=client.scheduler.address, start=False)
+    threading.Thread(target=bar._loop_runner.run_sync, args=(bar.listen,), daemon=True).start()
+    return bar
