@@ -46,6 +46,14 @@ def _fmt(v, unit: str = "") -> str:
 def sweep_cmd(study_file: str, store: str | None, workers: int | None, scheduler: str | None,
               exports: tuple[str, ...], progress: bool | None, min_dask_designs: int | None) -> None:
     """Run the design study STUDY_FILE (or resume it) into a zarr store."""
+    try:
+        _sweep(study_file, store, workers, scheduler, exports, progress, min_dask_designs)
+    except KeyboardInterrupt:  # before the run started (reading the study, starting Dask)
+        raise Interrupted("interrupted; nothing was computed") from None
+
+
+def _sweep(study_file: str, store: str | None, workers: int | None, scheduler: str | None,
+           exports: tuple[str, ...], progress: bool | None, min_dask_designs: int | None) -> None:
     from ..io import check_output
     from ..studies import load_study, run_study
     from ..studies.execute import IN_PROCESS_BELOW, MAX_WORKERS

@@ -49,20 +49,32 @@ _LOGGERS = ("distributed", "tornado", "asyncio", "bokeh")
 
 
 @contextlib.contextmanager
-def _silent():
-    """Dask's loggers off, and SIGINT ignored in this (main) thread, while a cluster is torn down."""
+def _silent(interrupt_after: bool = False):
+    """Dask's loggers off while a cluster starts or is torn down, and Ctrl-C held back.
+
+    A SIGINT in the block is noted instead of breaking Dask's start or shutdown half-way
+    (which prints tracebacks from its threads); with ``interrupt_after`` it is raised as
+    KeyboardInterrupt when the block has ended, else it is dropped (a run that ends anyway).
+    """
     levels = {n: logging.getLogger(n).level for n in _LOGGERS}
     for n in _LOGGERS:
         logging.getLogger(n).setLevel(logging.CRITICAL + 1)
     main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    caught: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda sig, frame: caught.append(sig)) if main else None
     try:
         yield
+    except BaseException:
+        if caught and interrupt_after:
+            raise KeyboardInterrupt from None  # what broke the block was the interrupt
+        raise
     finally:
         if main:
             signal.signal(signal.SIGINT, previous)
         for n, level in levels.items():
             logging.getLogger(n).setLevel(level)
+    if caught and interrupt_after:
+        raise KeyboardInterrupt
 
 
 def _ignore_interrupt() -> None:
@@ -95,23 +107,61 @@ def local_cluster(n_workers: int, **kwargs):
     use: the statistical profiler that samples each worker's thread every 10 ms (some 4 % of
     a worker's time), the 20 ms event-loop tick (it only warns of a blocked loop) and the
     0.5 s system monitor (the dashboard's CPU and memory plots, every 2 s here). On two cores
-    that background took a tenth of a core. The worker processes ignore SIGINT (Ctrl-C is the
-    client's to handle). Other keyword arguments go to ``LocalCluster``.
+    that background took a tenth of a core. The workers are forked from a server process that
+    has loaded and run the study code once (:mod:`impstab.studies.worker_preload`), and they
+    ignore SIGINT (:func:`_start_fork_server`): Ctrl-C is the client's to handle. Other keyword
+    arguments go to ``LocalCluster``.
     """
     import dask
     from distributed import LocalCluster
 
     kw = dict(threads_per_worker=1, processes=True, silence_logs=logging.ERROR)
     kw.update(kwargs)
+    with dask.config.set({**_QUIET_CLUSTER, **_fork_server()}):
+        return LocalCluster(n_workers=n_workers, **kw)
+
+
+_PRELOAD = ["distributed", "impstab.studies.distributed", "impstab.studies.worker_preload"]
+
+
+def _fork_server() -> dict:
+    """Dask settings that fork the workers from a server with the study code loaded and run once.
+
+    See :mod:`impstab.studies.worker_preload`; where the platform has no ``forkserver``,
+    nothing (the workers are spawned as Dask does by default).
+    """
+    import multiprocessing
+
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return {}
+    settings = {"distributed.worker.multiprocessing-method": "forkserver"}
+    import dask
+    from distributed.utils import get_mp_context
+
+    with dask.config.set(settings):
+        ctx = get_mp_context()  # Dask names its own modules to preload on first use ...
+    ctx.set_forkserver_preload(_PRELOAD)  # ... and these take their place
+    _start_fork_server()
+    return settings
+
+
+def _start_fork_server() -> None:
+    """Start the fork server now, ignoring SIGINT: it passes that on to every worker it forks.
+
+    A Ctrl-C in a terminal goes to every process of the foreground group: each worker would
+    stop with a traceback of its own. Ignored SIGINT survives the start of a new program, and
+    the server gives its workers the disposition it had after its preloads. The window in
+    which this process ignores SIGINT itself is the start of one process (milliseconds).
+    """
+    from multiprocessing import forkserver
+
     main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None  # inherited by the workers
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
-        with dask.config.set(_QUIET_CLUSTER):
-            cluster = LocalCluster(n_workers=n_workers, **kw)
+        forkserver.ensure_running()
     finally:
         if main:
             signal.signal(signal.SIGINT, previous)
-    return cluster
 
 
 class Session:
@@ -140,9 +190,11 @@ def connect(address: str) -> Session:
         with _silent():
             client = Client(text, timeout=f"{CONNECT_TIMEOUT}s")
     except Exception as exc:  # noqa: BLE001 - any failure to connect is reported in one line
-        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise ModelError("--scheduler", address, f"no Dask scheduler answered there within {CONNECT_TIMEOUT} s "
-                                                 f"({reason[:160]})") from None
+        reason = (str(exc).splitlines() or [type(exc).__name__])[0][:160]
+        if isinstance(exc, (OSError, TimeoutError)) and "unknown address scheme" not in reason:
+            raise ModelError("--scheduler", address, f"no Dask scheduler answered there within {CONNECT_TIMEOUT} s "
+                                                     f"({reason})") from None
+        raise ModelError("--scheduler", address, f"is not the address of a Dask scheduler ({reason})") from None
     return Session(client, [client])
 
 
@@ -156,12 +208,17 @@ def start_local(workers: int) -> Session:
         dashboard = ":0"
     except ImportError:
         dashboard = None
-    with _silent():
-        cluster = local_cluster(workers, dashboard_address=dashboard)
-        client = Client(cluster)
-        with contextlib.suppress(Exception):
-            client.register_plugin(_interrupt_plugin())  # also workers that a nanny restarts
-    return Session(client, [client, cluster])
+    owned: list = []
+    try:
+        with _silent(interrupt_after=True):
+            owned.append(local_cluster(workers, dashboard_address=dashboard))
+            owned.insert(0, Client(owned[0]))
+            with contextlib.suppress(Exception):
+                owned[0].register_plugin(_interrupt_plugin())  # workers spawned, not forked, ignore Ctrl-C too
+    except BaseException:
+        Session(None, owned).close()
+        raise
+    return Session(owned[0], owned)
 
 
 # -- the tasks ------------------------------------------------------------------------------------
