@@ -62,10 +62,16 @@ _REASONS = {
 
 
 def describe_os_error(exc: OSError) -> str:
-    """The reason of an OSError in words (no exception class names, no errno numbers)."""
+    """The reason of an OSError in words (no exception class names, no errno numbers).
+
+    The file it names is added unless it is a hidden file (one of the temporaries and lock
+    files written here, whose names mean nothing to the reader).
+    """
     text = _REASONS.get(exc.errno or -1) or (exc.strerror or str(exc) or type(exc).__name__).lower()
     name = getattr(exc, "filename", None)
-    return f"{text} ({name})" if name and exc.errno not in (errno.ENOSPC, errno.EDQUOT) else text
+    if name and not Path(str(name)).name.startswith(".") and exc.errno not in (errno.ENOSPC, errno.EDQUOT):
+        return f"{text} ({name})"
+    return text
 
 
 def output_error(option: str, path: str | os.PathLike[str], exc: OSError, after: str = "nothing was written") -> OutputError:

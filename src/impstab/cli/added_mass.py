@@ -141,11 +141,9 @@ def added_mass_cmd(radius: float, length: float, density: float, sound_speed: fl
 
 
 def _save_png(sweep, output: str) -> None:
-    from ..io import atomic_path
+    from ..io import save_figure
 
-    fig = sweep.plot()
-    with atomic_path(output) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+    save_figure(sweep.plot(), output, option="--output", dpi=120)
 
 
 commands = [added_mass_cmd]

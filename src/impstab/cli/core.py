@@ -118,7 +118,7 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="netCDF file (.nc); a PNG is written beside it")
 def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearization: str | None, output: str | None) -> None:
     """Eigenvalue loci against thrust: netCDF data and a PNG like the paper's Figure 4."""
-    from ..io import atomic_path
+    from ..io import check_output, write_netcdf
     from ..linear.critical_thrust import critical_thrust
     from ..linear.locus import locus
 
@@ -128,16 +128,16 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
     if output is not None and Path(output).suffix.lower() not in (".nc", ".png"):
         raise ModelError("--output", output, "must end in .nc (netCDF; a PNG is written beside it) or .png")
     model = _load(model_file)
+    out = Path(output) if output else Path(Path(model_file).stem + "-locus.nc")
+    check_output(out, option="--output")
     res = locus(model, steps=steps, thrust_max=thrust_max, linearization=linearization)
     crit = critical_thrust(model, thrust_max=res.thrust[-1], linearization=linearization)
     from dataclasses import replace
 
     res = replace(res, critical_thrust=crit.thrust)
-    out = Path(output) if output else Path(Path(model_file).stem + "-locus.nc")
     png = out.with_suffix(".png")
     if out.suffix.lower() == ".nc":
-        with atomic_path(out) as tmp:
-            res.to_xarray().to_netcdf(tmp, engine="h5netcdf")
+        write_netcdf(res.to_xarray(), out, option="--output")
     _save_png(res, png)
     con = console()
     con.print(f"critical thrust: {_fmt(crit.thrust, 'N')} ({crit.kind})")
@@ -153,13 +153,14 @@ def _save_png(res, png: Path) -> None:
     matplotlib.use("Agg", force=False) if matplotlib.get_backend().lower() != "agg" else None
     import matplotlib.pyplot as plt
 
-    from ..io import atomic_path
+    from ..io import save_figure
 
     axes = res.plot()
     fig = axes[0].figure
-    with atomic_path(png) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
-    plt.close(fig)
+    try:
+        save_figure(fig, png, option="--output", dpi=120)
+    finally:
+        plt.close(fig)
 
 
 @click.command("critical")

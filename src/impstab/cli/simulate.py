@@ -69,7 +69,7 @@ def _save_png(results, png: Path) -> None:
     matplotlib.use("Agg", force=False) if matplotlib.get_backend().lower() != "agg" else None
     import matplotlib.pyplot as plt
 
-    from ..io import atomic_path
+    from ..io import save_figure
     from ..plot.simulation import plot_simulations
 
     if len(results) == 1:
@@ -77,21 +77,20 @@ def _save_png(results, png: Path) -> None:
         fig = axes[0].figure
     else:
         fig = plot_simulations(results)[0, 0].figure
-    with atomic_path(png) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
-    plt.close(fig)
+    try:
+        save_figure(fig, png, option="--output", dpi=120)
+    finally:
+        plt.close(fig)
 
 
 def _write(results, out: Path) -> None:
     from ..dynamics.result import combine_results, results_to_dataframe
-    from ..io import atomic_path
+    from ..io import write_csv, write_netcdf
 
-    with atomic_path(out) as tmp:
-        if out.suffix.lower() == ".csv":
-            results_to_dataframe(results).to_csv(tmp, index=False)
-        else:
-            ds = results[0].to_xarray() if len(results) == 1 else combine_results(results)
-            ds.to_netcdf(tmp, engine="h5netcdf")
+    if out.suffix.lower() == ".csv":
+        write_csv(results_to_dataframe(results), out, option="--output", index=False)
+    else:
+        write_netcdf(results[0].to_xarray() if len(results) == 1 else combine_results(results), out, option="--output")
 
 
 def _table(results, model_name: str):
@@ -154,6 +153,9 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     if displace or kick:
         pert = {"displacement": _dof_values("--displace", displace), "velocity": _dof_values("--kick", kick)}
     model = load_model(model_file)
+    from ..io import check_output
+
+    check_output(out, option="--output")  # before the run, not after it
     crit = critical_thrust(model, linearization="equilibrium").thrust
     if len(values) > 1 and dt is None:  # one time grid for all runs
         dt = min(default_step(model, v) for v in values)

@@ -60,7 +60,9 @@ class RunLock:
         try:
             fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
         except OSError as exc:
-            raise output_error(self.field, self.root, exc, "nothing was changed") from None
+            error = output_error(self.field, self.root, exc, "nothing was changed")
+            error.errno = exc.errno
+            raise error from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:

@@ -29,6 +29,7 @@ named, chunks not computed yet are left at their fill values and named.
 from __future__ import annotations
 
 import datetime as _dt
+import errno
 import json
 import os
 import secrets
@@ -339,6 +340,7 @@ class StudyStore:
         self._writer: ChunkWriter | None = None
         self._written: dict[int, dict[str, np.ndarray]] = {}
         self.run_id = ""
+        self.read_only = False
 
     # -- opening --------------------------------------------------------------------------------
     @classmethod
@@ -427,7 +429,12 @@ class StudyStore:
             raise ModelError(field, str(path), f"cannot be read: {exc.strerror or exc}") from None
         intact = disk_root is not None and _root_intact(disk_root)
         _identify(study, path, field, disk_root, intact, progress)
-        lock = RunLock(path, field).acquire()
+        try:
+            lock = RunLock(path, field).acquire()
+        except ModelError as exc:
+            if getattr(exc, "errno", None) not in (errno.EROFS, errno.EACCES, errno.EPERM):
+                raise
+            return cls._read_only(study, plan, path, field, files_ref, root, disk_root, exc)
         try:
             links, partial = scan(path)
             if links:
@@ -470,7 +477,26 @@ class StudyStore:
         store.repaired = repaired
         return store
 
-    def _verify(self) -> None:
+    @classmethod
+    def _read_only(cls, study, plan, path: Path, field: str, files_ref: dict, root: dict, disk_root,
+                   error: ModelError) -> "StudyStore":
+        """A store this process cannot write: usable only if it is complete and intact (a rerun to export)."""
+        files = FolderFiles(path, field)
+        intact = disk_root is not None and _root_intact(disk_root)
+        if not intact or any(not _same(key, files.read(key), data) for key, data in files_ref.items()):
+            raise error
+        attrs = _attrs(disk_root)
+        store = cls(study, plan, files, str(path), path, root, {k: v for k, v in attrs.items() if k not in DYNAMIC},
+                    {k: attrs[k] for k in DYNAMIC if k in attrs}, None, False)
+        store.read_only = True
+        store._verify(remove_damaged=False)
+        if not store._done.all():
+            raise error
+        store.findings.append("the store cannot be written (read-only), but it is complete and verified: "
+                              "nothing is computed or recorded")
+        return store
+
+    def _verify(self, remove_damaged: bool = True) -> None:
         """Check every chunk against its record; a damaged chunk loses its record (computed again)."""
         damaged = []
         n_columns = len(columns(self.arrays))
@@ -483,7 +509,8 @@ class StudyStore:
             self._done[i] = check.state == "done"
             if check.state == "damaged":
                 damaged.append(check)
-                self.files.remove(record_key(i))
+                if remove_damaged:
+                    self.files.remove(record_key(i))
         self.recomputed = [c.index for c in damaged]
         if damaged:
             self.findings.append(f"computing {_count(len(damaged), 'chunk')} again, whose stored data do not match "
@@ -524,7 +551,8 @@ class StudyStore:
 
     # -- the run history --------------------------------------------------------------------------
     def _write_root(self) -> None:
-        self.files.write("zarr.json", _root_bytes(self._root, self._static, self._dynamic))
+        if not self.read_only:
+            self.files.write("zarr.json", _root_bytes(self._root, self._static, self._dynamic))
 
     def begin_run(self, executor: str) -> int:
         """Record the start of a run in the store's history; returns its position."""
