@@ -707,9 +707,12 @@ def read_store(files: StoreFiles, name: str, field: str = "STORE", data: bool = 
     attrs = _attrs(root)
     fmt = attrs.get("format")
     if not (isinstance(fmt, str) and fmt.startswith("impstab-study-store")):
-        if root_bytes is not None and "consolidated_metadata" not in (root or {}):
-            raise ModelError(field, name, "its metadata (zarr.json) are damaged or it is not an impstab study store: "
-                                          "if it is one, run the study again (impstab sweep STUDY -o STORE) to repair it")
+        ours = "fingerprint" in _attrs(_json(files.read("progress/zarr.json")))
+        if ours or (root_bytes is not None and "consolidated_metadata" not in (root or {})):
+            state = "missing" if root_bytes is None else "damaged"
+            raise ModelError(field, name, f"its metadata (zarr.json) are {state}" + ("" if ours else
+                                          " or it is not an impstab study store") + ": run the study again "
+                                          "(impstab sweep STUDY -o STORE) to repair them")
         raise ModelError(field, name, "is not an impstab study store")
     if fmt != FORMAT:
         raise ModelError(field, name, f"was written in an older store format ({fmt}) that cannot be verified: "
