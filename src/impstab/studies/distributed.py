@@ -109,13 +109,14 @@ def local_cluster(n_workers: int, **kwargs):
     0.5 s system monitor (the dashboard's CPU and memory plots, every 2 s here). On two cores
     that background took a tenth of a core. The workers are forked from a server process that
     has loaded and run the study code once (:mod:`impstab.studies.worker_preload`), and they
-    ignore SIGINT (:func:`_start_fork_server`): Ctrl-C is the client's to handle. Other keyword
-    arguments go to ``LocalCluster``.
+    ignore SIGINT (:func:`_start_fork_server`): Ctrl-C is the client's to handle. Their log
+    lines are off below CRITICAL (a failed task reaches the client as its exception; the
+    shutdown races of heartbeats are noise). Other keyword arguments go to ``LocalCluster``.
     """
     import dask
     from distributed import LocalCluster
 
-    kw = dict(threads_per_worker=1, processes=True, silence_logs=logging.ERROR)
+    kw = dict(threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL)
     kw.update(kwargs)
     with dask.config.set({**_QUIET_CLUSTER, **_fork_server()}):
         return LocalCluster(n_workers=n_workers, **kw)

@@ -153,9 +153,9 @@ def _run(study, plan, st: StudyStore, workers, scheduler, client, owned: list, p
     if asked and todo:
         n_workers = workers if workers is not None else _worker_count(client or session.client)
         if in_process_below and (designs < in_process_below or len(todo) < 2 * n_workers):
-            where = (f"in-process: {designs} designs in {len(todo)} chunks to compute, too few to share "
-                     f"(a Dask run needs {in_process_below} designs and 2 chunks per worker)")
-            say(f"{where}; Dask was not started")
+            where = (f"in-process: {designs} designs in {len(todo)} chunks to compute, too few to share among "
+                     f"{n_workers} workers (Dask is used from {in_process_below} designs and 2 chunks per worker)")
+            say(where)
             asked = False
     if asked and todo and client is None and session is None:
         from .distributed import start_local
