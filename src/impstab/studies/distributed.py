@@ -248,10 +248,10 @@ _WRITERS: dict = {}
 def _store_is_this_run(target: StoreTarget) -> bool:
     import json
 
-    from .store import _attrs, _json
     from .store_files import FolderFiles
+    from .store_layout import attributes, json_doc
 
-    attrs = _attrs(_json(FolderFiles(Path(target.path)).read("zarr.json")))
+    attrs = attributes(json_doc(FolderFiles(Path(target.path)).read("zarr.json")))
     try:
         history = json.loads(attrs.get("history", "[]"))
     except ValueError:

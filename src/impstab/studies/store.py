@@ -28,14 +28,12 @@ named, chunks not computed yet are left at their fill values and named.
 
 from __future__ import annotations
 
-import datetime as _dt
 import errno
 import json
 import os
 import secrets
 import shutil
 import time
-import zlib
 from pathlib import Path
 from typing import Any
 
@@ -43,214 +41,19 @@ import numpy as np
 
 from ..errors import ModelError
 from ..io import output_error, owner_tag, remove_stale
-from ..linear.batch import KINDS, STATUSES
-from .evaluate import CODE_OUTPUTS, ChunkResult
+from .evaluate import ChunkResult
 from .lock import RunLock
 from .plan import ChunkPlan
-from .records import Check, check_chunk, columns, decode, encode, file_checksum, record_key
-from .schema import OUTPUTS
+from .records import check_chunk, columns, decode, encode, file_checksum, record_key
 from .store_files import FolderFiles, MemoryFiles, StoreFiles, StoreLinkError, scan
-from .study import Study, describe
+from .store_layout import (DYNAMIC, FORMAT, INTEGRITY, attributes, chunk_arrays, count, data_key, fresh_dynamic,
+                           history_list, json_doc, names, now_iso, reference_files, root_bytes, root_intact, same_file,
+                           static_attrs, tidy)
+from .store_read import StoreView, read_store
+from .study import Study
 
 __all__ = ["StudyStore", "ChunkWriter", "StoreView", "read_store", "now_iso", "tidy", "chunk_arrays", "data_key",
            "FORMAT"]
-
-FORMAT = "impstab-study-store/2"
-#: root attributes that change from run to run (all others are fixed when the store is made)
-DYNAMIC = ("updated", "completed", "complete", "history")
-_INTEGRITY = "integrity"
-
-
-def now_iso() -> str:
-    """The current UTC time, ISO 8601 to the second."""
-    return _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
-
-
-def chunk_arrays(outputs) -> tuple[str, ...]:
-    """The arrays each chunk of the store holds: the outputs, ``status`` and ``message``."""
-    return (*outputs, "status", "message")
-
-
-def data_key(name: str, plan: ChunkPlan, index: int) -> str:
-    """The key of chunk ``index``'s file of array ``name``."""
-    pos = np.unravel_index(index, plan.grid)
-    return f"{name}/c/" + "/".join(str(int(p)) for p in pos)
-
-
-def _variable_attrs(name: str) -> dict[str, Any]:
-    if name == "status":
-        return {
-            "long_name": "status of the design",
-            "flag_values": list(range(len(STATUSES))),
-            "flag_meanings": " ".join(STATUSES),
-            "comment": "-1: not computed yet; see 'message' for the reason of a failure",
-        }
-    if name == "message":
-        return {"long_name": "why the design failed (empty when status is ok)"}
-    units, text = OUTPUTS[name]
-    attrs: dict[str, Any] = {"long_name": text}
-    if units:
-        attrs["units"] = units
-    if name in CODE_OUTPUTS:
-        attrs.update(flag_values=list(range(len(KINDS))), flag_meanings=" ".join(KINDS),
-                     comment="-1: not available (the design failed or is not computed)")
-    return attrs
-
-
-def _kind(name: str) -> tuple[Any, Any]:
-    if name in ("message", "modes"):
-        return str, ""
-    if name == "status" or name in CODE_OUTPUTS:
-        return "i1", -1
-    return "f8", np.nan
-
-
-# -- the static part ------------------------------------------------------------------------------
-def _static_attrs(study: Study, plan: ChunkPlan, created: str) -> dict[str, Any]:
-    from .. import __version__
-
-    attrs = {
-        "title": f"design study {study.name}",
-        "format": FORMAT,
-        "study_name": study.name,
-        "study_file": study.study_text,
-        "study_path": study.source or "",
-        "model_file": study.model_text,
-        "model_path": study.model_source or "",
-        "model_name": study.model_name,
-        "impstab_version": __version__,
-        "fingerprint": study.fingerprint,
-        "created": created,
-        "chunk_shape": list(plan.chunks),
-        "n_chunks": plan.n_chunks,
-        "kind_legend": json.dumps(dict(enumerate(KINDS))),
-        "status_legend": json.dumps(dict(enumerate(STATUSES))),
-    }
-    attrs.update({k: (json.dumps(v) if isinstance(v, list) else v) for k, v in describe(study).items()})
-    return attrs
-
-
-def _fresh_dynamic() -> dict[str, Any]:
-    return {"updated": now_iso(), "completed": "", "complete": 0, "history": "[]"}
-
-
-def _canonical(obj) -> bytes:
-    return json.dumps(obj, sort_keys=True, separators=(",", ":")).encode()
-
-
-def _integrity(static: dict, consolidated) -> int:
-    return zlib.crc32(_canonical({"attributes": {k: v for k, v in static.items() if k != _INTEGRITY},
-                                  "consolidated_metadata": consolidated}))
-
-
-def _root_bytes(reference_root: dict, static: dict, dynamic: dict) -> bytes:
-    doc = dict(reference_root)
-    attrs = {k: v for k, v in static.items() if k != _INTEGRITY}
-    attrs[_INTEGRITY] = _integrity(attrs, doc.get("consolidated_metadata"))
-    attrs.update(dynamic)
-    doc["attributes"] = attrs
-    return json.dumps(doc, indent=2).encode()
-
-
-def _reference(study: Study, plan: ChunkPlan) -> tuple[dict[str, bytes], dict]:
-    """Every file of the static part as the store must hold it, and the root document.
-
-    The root ``zarr.json`` is not among the files: its attributes are composed per run
-    (:func:`_root_bytes`).
-    """
-    import zarr
-
-    store_dict: dict = {}
-    group = zarr.open_group(zarr.storage.MemoryStore(store_dict=store_dict), mode="w", zarr_format=3)
-    dims = list(study.dims)
-    coords = [p.name for p in study.parameters]
-    for p in study.parameters:
-        vals = p.values
-        dtype = str if vals.dtype.kind == "U" else vals.dtype
-        grid = study.method == "grid"
-        arr = group.create_array(p.name, shape=vals.shape, dtype=dtype, chunks=vals.shape if grid else plan.chunks,
-                                 dimension_names=[p.name] if grid else dims,
-                                 attributes={"long_name": f"model-file value {p.name}"})
-        arr[...] = vals
-    if study.method != "grid":
-        coords.append("sample")
-        arr = group.create_array("sample", shape=study.shape, dtype="i8", chunks=plan.chunks, dimension_names=dims)
-        arr[...] = np.arange(study.size)
-    arrays = chunk_arrays(study.outputs)
-    for name in arrays:
-        dtype, fill = _kind(name)
-        group.create_array(name, shape=study.shape, dtype=dtype, chunks=plan.chunks, fill_value=fill,
-                           dimension_names=dims, attributes=_variable_attrs(name))
-    coordinate_files = {k: list(file_checksum(v.to_bytes())) for k, v in store_dict.items()
-                        if k.split("/")[0] in coords and not k.endswith("zarr.json")}
-    cols = columns(arrays)
-    prog = group.create_group("progress", attributes={"fingerprint": study.fingerprint, "arrays": list(arrays),
-                                                      "coordinate_files": coordinate_files})
-    prog.create_array("chunks", shape=(plan.n_chunks, len(cols)), dtype="f8", chunks=(1, len(cols)),
-                      fill_value=np.nan, compressors=None, dimension_names=["chunk", "record"],
-                      attributes={"columns": list(cols),
-                                  "comment": "one completion record per chunk: see impstab.studies.records"})
-    _consolidate(group.store)
-    files = {k: v.to_bytes() for k, v in store_dict.items()}
-    root = json.loads(files.pop("zarr.json"))
-    return files, root
-
-
-def _consolidate(store) -> None:
-    """Consolidated metadata (fixed once the arrays exist), so that readers open the store fast."""
-    import warnings
-
-    import zarr
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # "not part of the Zarr format 3 specification (yet)"
-        zarr.consolidate_metadata(store)
-
-
-def _json(data: bytes | None):
-    if data is None:
-        return None
-    try:
-        doc = json.loads(data)
-    except (ValueError, UnicodeDecodeError):
-        return None
-    return doc if isinstance(doc, dict) else None
-
-
-def _attrs(doc) -> dict:
-    attrs = doc.get("attributes") if isinstance(doc, dict) else None
-    return attrs if isinstance(attrs, dict) else {}
-
-
-def _root_intact(doc) -> bool:
-    attrs = _attrs(doc)
-    static = {k: v for k, v in attrs.items() if k not in DYNAMIC}
-    return _INTEGRITY in attrs and attrs[_INTEGRITY] == _integrity(static, doc.get("consolidated_metadata"))
-
-
-def _same(key: str, disk: bytes | None, ref: bytes) -> bool:
-    if disk is None:
-        return False
-    if key.endswith("zarr.json"):
-        return _json(disk) is not None and _json(disk) == _json(ref)
-    return disk == ref
-
-
-def _history(text) -> list | None:
-    try:
-        history = json.loads(text) if isinstance(text, str) else None
-    except ValueError:
-        return None
-    return history if isinstance(history, list) and all(isinstance(h, dict) for h in history) else None
-
-
-def _names(items: list[str], limit: int = 6) -> str:
-    shown = ", ".join(items[:limit])
-    return shown + (f" and {len(items) - limit} more" if len(items) > limit else "")
-
-
-def _count(n: int, what: str) -> str:
-    return f"{n} {what}" + ("" if n == 1 else "s")
 
 
 def _stale_note(p: Path) -> str:
@@ -358,7 +161,7 @@ class StudyStore:
             Not a store of this study, another run writes it, a symbolic link inside it, or it
             cannot be written (:class:`impstab.io.OutputError`).
         """
-        files_ref, root = _reference(study, plan)
+        files_ref, root = reference_files(study, plan)
         if path is None:
             import zarr
 
@@ -366,8 +169,8 @@ class StudyStore:
             files = MemoryFiles(store_dict)
             for key, data in files_ref.items():
                 files.write(key, data)
-            static, dynamic = _static_attrs(study, plan, now_iso()), _fresh_dynamic()
-            files.write("zarr.json", _root_bytes(root, static, dynamic))
+            static, dynamic = static_attrs(study, plan, now_iso()), fresh_dynamic()
+            files.write("zarr.json", root_bytes(root, static, dynamic))
             return cls(study, plan, files, zarr.storage.MemoryStore(store_dict=store_dict), None, root, static,
                        dynamic, None, True)
         path = Path(path)
@@ -394,8 +197,8 @@ class StudyStore:
             files = FolderFiles(tmp, field)
             for key, data in files_ref.items():
                 files.write(key, data)
-            static, dynamic = _static_attrs(study, plan, now_iso()), _fresh_dynamic()
-            files.write("zarr.json", _root_bytes(root, static, dynamic))
+            static, dynamic = static_attrs(study, plan, now_iso()), fresh_dynamic()
+            files.write("zarr.json", root_bytes(root, static, dynamic))
             try:
                 os.rename(tmp, path)
             except OSError:
@@ -423,11 +226,11 @@ class StudyStore:
         files = FolderFiles(path, field)
         findings = [_stale_note(p) for p in remove_stale(path.parent, f".{path.name}.creating-")]
         try:
-            disk_root = _json(files.read("zarr.json"))
-            progress = _json(files.read("progress/zarr.json"))
+            disk_root = json_doc(files.read("zarr.json"))
+            progress = json_doc(files.read("progress/zarr.json"))
         except OSError as exc:
             raise ModelError(field, str(path), f"cannot be read: {exc.strerror or exc}") from None
-        intact = disk_root is not None and _root_intact(disk_root)
+        intact = disk_root is not None and root_intact(disk_root)
         _identify(study, path, field, disk_root, intact, progress)
         try:
             lock = RunLock(path, field).acquire()
@@ -444,20 +247,20 @@ class StudyStore:
                     p.unlink()
                 except OSError:
                     pass
-            repaired = [key for key, data in files_ref.items() if not _same(key, files.read(key), data)]
+            repaired = [key for key, data in files_ref.items() if not same_file(key, files.read(key), data)]
             for key in repaired:
                 files.write(key, files_ref[key])
-            attrs = _attrs(disk_root)
+            attrs = attributes(disk_root)
             created = attrs.get("created") if isinstance(attrs.get("created"), str) else now_iso()
             static = ({k: v for k, v in attrs.items() if k not in DYNAMIC} if intact
-                      else _static_attrs(study, plan, created))
-            dynamic = _fresh_dynamic()
-            history = _history(attrs.get("history"))
+                      else static_attrs(study, plan, created))
+            dynamic = fresh_dynamic()
+            history = history_list(attrs.get("history"))
             if history is not None:
                 dynamic.update({k: attrs[k] for k in DYNAMIC if k in attrs and k != "history"})
                 dynamic["history"] = json.dumps(history)
-            root_now = _root_bytes(root, static, dynamic)
-            if not intact or _json(root_now) != disk_root:
+            root_now = root_bytes(root, static, dynamic)
+            if not intact or json_doc(root_now) != disk_root:
                 repaired.insert(0, "zarr.json" + ("" if history is not None else " (its run history was lost)"))
                 files.write("zarr.json", root_now)
             store = cls(study, plan, files, str(path), path, root, static, dynamic, lock, False)
@@ -469,10 +272,10 @@ class StudyStore:
             lock.release()
             raise
         if partial:
-            findings.append(f"removed {_count(len(partial), 'temporary file')} of writes cut short")
+            findings.append(f"removed {count(len(partial), 'temporary file')} of writes cut short")
         if repaired:
-            findings.append(f"repaired {_count(len(repaired), 'metadata or coordinate file')} from the study: "
-                            f"{_names(repaired)}")
+            findings.append(f"repaired {count(len(repaired), 'metadata or coordinate file')} from the study: "
+                            f"{names(repaired)}")
         store.findings = findings + store.findings
         store.repaired = repaired
         return store
@@ -482,10 +285,10 @@ class StudyStore:
                    error: ModelError) -> "StudyStore":
         """A store this process cannot write: usable only if it is complete and intact (a rerun to export)."""
         files = FolderFiles(path, field)
-        intact = disk_root is not None and _root_intact(disk_root)
-        if not intact or any(not _same(key, files.read(key), data) for key, data in files_ref.items()):
+        intact = disk_root is not None and root_intact(disk_root)
+        if not intact or any(not same_file(key, files.read(key), data) for key, data in files_ref.items()):
             raise error
-        attrs = _attrs(disk_root)
+        attrs = attributes(disk_root)
         store = cls(study, plan, files, str(path), path, root, {k: v for k, v in attrs.items() if k not in DYNAMIC},
                     {k: attrs[k] for k in DYNAMIC if k in attrs}, None, False)
         store.read_only = True
@@ -513,8 +316,8 @@ class StudyStore:
                     self.files.remove(record_key(i))
         self.recomputed = [c.index for c in damaged]
         if damaged:
-            self.findings.append(f"computing {_count(len(damaged), 'chunk')} again, whose stored data do not match "
-                                 "the completion record: " + _names([c.describe() for c in damaged]))
+            self.findings.append(f"computing {count(len(damaged), 'chunk')} again, whose stored data do not match "
+                                 "the completion record: " + names([c.describe() for c in damaged]))
 
     # -- progress ---------------------------------------------------------------------------------
     def todo(self) -> list[int]:
@@ -552,7 +355,7 @@ class StudyStore:
     # -- the run history --------------------------------------------------------------------------
     def _write_root(self) -> None:
         if not self.read_only:
-            self.files.write("zarr.json", _root_bytes(self._root, self._static, self._dynamic))
+            self.files.write("zarr.json", root_bytes(self._root, self._static, self._dynamic))
 
     def begin_run(self, executor: str) -> int:
         """Record the start of a run in the store's history; returns its position."""
@@ -636,7 +439,7 @@ def _identify(study: Study, path: Path, field: str, root, intact: bool, progress
     """Refuse anything but a store of this study made by this version (damaged metadata of one is fine)."""
     from .. import __version__
 
-    attrs = _attrs(root)
+    attrs = attributes(root)
     fmt = attrs.get("format")
     if intact:
         if fmt != FORMAT:
@@ -650,119 +453,12 @@ def _identify(study: Study, path: Path, field: str, root, intact: bool, progress
                              f"was started with impstab {attrs.get('impstab_version')}, this is {__version__}: "
                              "finish it with that version or start a new store")
         return
-    if isinstance(fmt, str) and fmt.startswith("impstab-study-store/") and fmt != FORMAT and _INTEGRITY not in attrs:
+    if isinstance(fmt, str) and fmt.startswith("impstab-study-store/") and fmt != FORMAT and INTEGRITY not in attrs:
         raise ModelError(field, str(path), f"was written in an older store format ({fmt}, without checksums): "
                                            "finish it with the impstab version that started it, or start a new store")
-    if attrs.get("fingerprint") == study.fingerprint or _attrs(progress).get("fingerprint") == study.fingerprint:
+    if attrs.get("fingerprint") == study.fingerprint or attributes(progress).get("fingerprint") == study.fingerprint:
         return  # ours, with damaged metadata: repaired from the study
     if root is None and progress is None:
         raise ModelError(field, str(path), "exists and is not an impstab study store (give a new path)")
     raise ModelError(field, str(path), "exists, but its metadata are damaged and do not name this study: "
                                        "give a new path, or remove it to start again")
-
-
-# -- reading --------------------------------------------------------------------------------------
-class StoreView:
-    """What :func:`read_store` found: the dataset, and the chunks not computed yet."""
-
-    def __init__(self, dataset, pending: list[int], n_chunks: int) -> None:
-        self.dataset = dataset
-        self.pending = pending
-        self.n_chunks = n_chunks
-
-
-def read_store(files: StoreFiles, name: str, field: str = "STORE", data: bool = True) -> StoreView:
-    """Read a store, decoding only what is verified.
-
-    The root metadata must match their CRC-32, every coordinate file the size and CRC-32 noted
-    when the store was made, and every chunk with a completion record the sizes and CRC-32s
-    of its record. Chunks without a record are not computed yet: their designs keep the fill
-    values (status -1), whatever files they may hold. The verified files are decoded by zarr
-    from memory, so nothing unverified ever reaches a decoder.
-
-    Parameters
-    ----------
-    files : StoreFiles
-    name : str
-        The store's name in messages.
-    field : str
-        How it was given (``STORE``, ``--output``).
-    data : bool
-        False: the chunks' data are left out (coordinates and attributes only).
-
-    Raises
-    ------
-    ModelError
-        Not a study store, damaged metadata, or damaged chunks (named).
-    """
-    import xarray as xr
-    import zarr
-    from zarr.buffer import default_buffer_prototype
-
-    try:
-        root_bytes = files.read("zarr.json")
-    except OSError as exc:
-        raise ModelError(field, name, f"cannot be read: {exc.strerror or exc}") from None
-    root = _json(root_bytes)
-    attrs = _attrs(root)
-    fmt = attrs.get("format")
-    if not (isinstance(fmt, str) and fmt.startswith("impstab-study-store")):
-        ours = "fingerprint" in _attrs(_json(files.read("progress/zarr.json")))
-        if ours or (root_bytes is not None and "consolidated_metadata" not in (root or {})):
-            state = "missing" if root_bytes is None else "damaged"
-            raise ModelError(field, name, f"its metadata (zarr.json) are {state}" + ("" if ours else
-                                          " or it is not an impstab study store") + ": run the study again "
-                                          "(impstab sweep STUDY -o STORE) to repair them")
-        raise ModelError(field, name, "is not an impstab study store")
-    if fmt != FORMAT:
-        raise ModelError(field, name, f"was written in an older store format ({fmt}) that cannot be verified: "
-                                      "read it with the impstab version that made it")
-    if not _root_intact(root):
-        raise ModelError(field, name, "its metadata (zarr.json) do not match their checksum: run the study again "
-                                      "(impstab sweep STUDY -o STORE) to repair them")
-    meta = root["consolidated_metadata"]["metadata"]
-    prog = meta["progress"]["attributes"]
-    arrays = tuple(prog["arrays"])
-    plan = ChunkPlan(tuple(json.loads(attrs["shape"])), tuple(attrs["chunk_shape"]))
-    view: dict = {"zarr.json": root_bytes}
-    damaged: list[str] = []
-    pending: list[int] = []
-    try:
-        for key, (size, crc) in prog["coordinate_files"].items():
-            got = files.read(key)
-            if file_checksum(got) != (size, crc):
-                damaged.append(f"coordinate file {key} " + ("missing" if got is None else "damaged"))
-            view[key] = got
-        for i in range(plan.n_chunks if data else 0):
-            got: dict = {}
-
-            def read(key, got=got):
-                got[key] = files.read(key)
-                return got[key]
-
-            check = check_chunk(i, files.read(record_key(i)), arrays, [data_key(n, plan, i) for n in arrays], read)
-            if check.state == "pending":
-                pending.append(i)
-            elif check.state == "damaged":
-                damaged.append(check.describe())
-            else:
-                view.update(got)
-    except OSError as exc:
-        raise ModelError(field, name, f"cannot be read: {exc.strerror or exc}") from None
-    if damaged:
-        raise ModelError(field, name, f"holds damaged data ({_count(len(damaged), 'part')} do not match their "
-                                      f"checksums): {_names(damaged)}; run the study again (impstab sweep STUDY "
-                                      "-o STORE) to compute them again")
-    proto = default_buffer_prototype().buffer
-    mem = zarr.storage.MemoryStore(store_dict={k: proto.from_bytes(v) for k, v in view.items() if v is not None})
-    ds = tidy(xr.open_zarr(mem, consolidated=True, chunks=None)).load()
-    return StoreView(ds, pending, plan.n_chunks)
-
-
-def tidy(ds):
-    """Parameters as coordinates; outputs in the study file's order, then status and message."""
-    params = json.loads(ds.attrs.get("parameters", "[]"))
-    ds = ds.set_coords([p for p in params if p in ds.data_vars])
-    ds.attrs.pop(_INTEGRITY, None)
-    order = [*json.loads(ds.attrs.get("outputs", "[]")), "status", "message"]
-    return ds[[v for v in order if v in ds.data_vars] + [v for v in ds.data_vars if v not in order]]
