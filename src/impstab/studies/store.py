@@ -14,15 +14,16 @@ What proves what:
   every file of the chunk has the size and CRC-32 its record gives. The record is written after
   the data, by the process that wrote them, so a chunk cut short by a kill has no record.
 * **The static part** -- every ``zarr.json`` and the coordinate arrays -- follows from the study
-  alone: a run builds it in memory (:func:`_reference`), and a resume compares the store with it
-  file by file and rewrites what differs. The root ``zarr.json`` also carries the CRC-32 of its
-  own fixed attributes and consolidated metadata (``integrity``), for readers that have no study.
+  alone: a run builds it in memory (:func:`~impstab.studies.store_layout.reference_files`), and a
+  resume compares the store with it file by file and rewrites what differs. The root
+  ``zarr.json`` also carries the CRC-32 of its own fixed attributes and consolidated metadata
+  (``integrity``), for readers that have no study.
 
 A resume (:meth:`StudyStore.create_or_resume`) takes the lock, refuses a store with a symbolic
 link inside (nothing is ever written outside the store), removes the temporary files of writes
 cut short, repairs the static part, and verifies every chunk: a damaged one (a file missing,
 truncated or corrupt, or its record damaged) is said and computed again. A reader
-(:func:`read_store`) decodes only what it verified: damaged data are refused with the chunks
+(:func:`~impstab.studies.store_read.read_store`) decodes only what it verified: damaged data are refused with the chunks
 named, chunks not computed yet are left at their fill values and named.
 """
 
