@@ -44,6 +44,7 @@ _QUIET_CLUSTER = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.tick.interval": "1s",
     "distributed.admin.system-monitor.interval": "2s",
+    "distributed.scheduler.worker-saturation": "inf",
 }
 _LOGGERS = ("distributed", "tornado", "asyncio", "bokeh")
 

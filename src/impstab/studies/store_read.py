@@ -15,7 +15,7 @@ from ..errors import ModelError
 from .plan import ChunkPlan
 from .records import check_chunk, file_checksum, record_key
 from .store_files import StoreFiles
-from .store_layout import FORMAT, attributes, count, data_key, json_doc, names, root_intact, tidy
+from .store_layout import FORMAT, attributes, data_key, json_doc, names, root_intact, tidy
 
 __all__ = ["StoreView", "read_store"]
 
@@ -107,9 +107,8 @@ def read_store(files: StoreFiles, name: str, field: str = "STORE", data: bool = 
     except OSError as exc:
         raise ModelError(field, name, f"cannot be read: {exc.strerror or exc}") from None
     if damaged:
-        raise ModelError(field, name, f"holds damaged data ({count(len(damaged), 'part')} do not match their "
-                                      f"checksums): {names(damaged)}; run the study again (impstab sweep STUDY "
-                                      "-o STORE) to compute them again")
+        raise ModelError(field, name, f"holds damaged data, which do not match their checksums: {names(damaged)}; "
+                                      "run the study again (impstab sweep STUDY -o STORE) to compute them again")
     proto = default_buffer_prototype().buffer
     mem = zarr.storage.MemoryStore(store_dict={k: proto.from_bytes(v) for k, v in view.items() if v is not None})
     ds = tidy(xr.open_zarr(mem, consolidated=True, chunks=None)).load()
