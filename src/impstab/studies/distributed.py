@@ -223,6 +223,45 @@ def start_local(workers: int) -> Session:
     return Session(owned[0], owned)
 
 
+class ClusterStart:
+    """A local cluster started in a background thread, so that this process computes meanwhile.
+
+    Starting ``workers`` processes takes seconds (the fork server imports and warms up the study
+    code first); a run computes its first chunks in process in that time and hands the rest to
+    the workers once :meth:`ready`. The fork server itself is started here, in the calling
+    (main) thread, so that its workers ignore SIGINT.
+    """
+
+    def __init__(self, workers: int) -> None:
+        _fork_server()
+        self.session: Session | None = None
+        self.error: BaseException | None = None
+        self._thread = threading.Thread(target=self._start, args=(workers,), name="impstab-cluster-start",
+                                        daemon=True)
+        self._thread.start()
+
+    def _start(self, workers: int) -> None:
+        try:
+            self.session = start_local(workers)
+        except BaseException as exc:  # noqa: BLE001 - reported by the run, which then goes on in process
+            self.error = exc
+
+    def ready(self) -> bool:
+        """Whether the start has ended (with a cluster, or with :attr:`error`)."""
+        return not self._thread.is_alive()
+
+    def wait(self) -> "Session | None":
+        """The started session (None if the start failed), once the start has ended."""
+        with _silent():
+            self._thread.join()
+        return self.session
+
+    def close(self) -> None:
+        """Wait for the start to end, then shut the cluster down."""
+        if self.wait() is not None:
+            self.session.close()
+
+
 # -- the tasks ------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class StoreTarget:

@@ -4,11 +4,13 @@ In process (the default) the chunks run one after the other in this process, eac
 of designs through the batched engine, with a rich progress bar (rate and ETA). ``workers=N``
 starts a local Dask cluster of N single-threaded worker processes; ``scheduler=ADDRESS`` uses an
 existing ``dask.distributed`` cluster (:mod:`impstab.studies.distributed`): each worker writes
-the chunks it computes into the store itself, and this process only schedules.
+the chunks it computes into the store itself, and this process only schedules. While a local
+cluster starts (seconds: its workers' imports and first compiled calls), this process computes
+the first chunks itself, so that the start costs the run little.
 
-**Small studies stay in process.** Starting a local cluster costs about 1.5 s on two cores
-(worker processes, imports, first compiled calls) and each task some milliseconds of
-scheduling, so a run on Dask pays only when there is enough to share: fewer than
+**Small studies stay in process.** Starting a local cluster costs some 2 s of CPU on two cores
+and each task some milliseconds of scheduling, so a run on Dask pays only when there is enough
+to share: fewer than
 :data:`IN_PROCESS_BELOW` designs to compute, or fewer than two chunks per worker, run in this
 process, and the run's history and output say so.
 
@@ -21,7 +23,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-from typing import Callable, Iterator
+from typing import Callable
 
 from ..errors import ModelError
 from ..io import output_error
@@ -157,11 +159,6 @@ def _run(study, plan, st: StudyStore, workers, scheduler, client, owned: list, p
                      f"{n_workers} workers (Dask is used from {in_process_below} designs and 2 chunks per worker)")
             say(where)
             asked = False
-    if asked and todo and client is None and session is None:
-        from .distributed import start_local
-
-        session = start_local(workers)
-        owned.append(session)
     computed = [0]
 
     def done(index: int) -> None:
@@ -175,9 +172,26 @@ def _run(study, plan, st: StudyStore, workers, scheduler, client, owned: list, p
     try:
         run = st.begin_run(f"dask: {label}" if dask else where)
         if dask:
-            from .distributed import run_on_dask
+            from .distributed import ClusterStart, run_on_dask
 
-            how = run_on_dask(client if client is not None else session.client, st, study, plan, todo, done, progress)
+            early = 0
+            if client is None and session is None:  # compute here while the local cluster starts
+                start = ClusterStart(workers)
+                owned.append(start)
+                rest = _run_local(study, plan, st, todo, done, progress, until=start.ready)
+                early, todo = len(todo) - len(rest), rest
+                session = start.wait()
+                if session is None:
+                    say(f"the local Dask cluster did not start ({type(start.error).__name__}: {start.error}); "
+                        "the study goes on in this process")
+                    _run_local(study, plan, st, todo, done, progress)
+                    todo = []
+            how = "this process computed every chunk"
+            if todo:
+                how = run_on_dask(client if client is not None else session.client, st, study, plan, todo, done,
+                                  progress)
+            if early:
+                how += f"; this process computed {early} chunks while the cluster started"
             st.set_executor(run, f"dask: {label} ({how})")
         elif todo:
             _run_local(study, plan, st, todo, done, progress)
@@ -218,16 +232,16 @@ def _prod(shape) -> int:
     return out
 
 
-def _tasks(study: Study, plan: ChunkPlan, todo: list[int]) -> Iterator[ChunkTask]:
-    return (chunk_task(study, plan, i) for i in todo)
-
-
-def _run_local(study: Study, plan: ChunkPlan, st: StudyStore, todo: list[int], done: Callable, progress: bool) -> None:
+def _run_local(study: Study, plan: ChunkPlan, st: StudyStore, todo: list[int], done: Callable, progress: bool,
+               until: Callable[[], bool] | None = None) -> list[int]:
+    """Compute and write the chunks ``todo`` here, in order, until ``until()`` is true; return the rest."""
+    stop = until or (lambda: False)
+    rest = list(todo)
     if not progress:
-        for task in _tasks(study, plan, todo):
-            st.write(evaluate_chunk(task))
-            done(task.index)
-        return
+        while rest and not stop():
+            st.write(evaluate_chunk(chunk_task(study, plan, rest[0])))
+            done(rest.pop(0))
+        return rest
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, ProgressColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
     from rich.text import Text
@@ -239,9 +253,11 @@ def _run_local(study: Study, plan: ChunkPlan, st: StudyStore, todo: list[int], d
 
     columns = (TextColumn("designs"), BarColumn(), MofNCompleteColumn(), Rate(), TimeElapsedColumn(),
                TextColumn("ETA"), TimeRemainingColumn())
-    with Progress(*columns, console=Console(stderr=True)) as bar:
+    with Progress(*columns, console=Console(stderr=True), transient=until is not None) as bar:
         job = bar.add_task("designs", total=sum(_prod(plan.block_shape(i)) for i in todo))
-        for task in _tasks(study, plan, todo):
-            st.write(evaluate_chunk(task))
-            done(task.index)
-            bar.advance(job, _prod(task.block))
+        while rest and not stop():
+            index = rest.pop(0)
+            st.write(evaluate_chunk(chunk_task(study, plan, index)))
+            done(index)
+            bar.advance(job, _prod(plan.block_shape(index)))
+    return rest
