@@ -205,3 +205,61 @@ def test_the_client_killed_mid_run_then_resumed(tmp_path, slow, after):
     assert res.complete
     assert_same_store(store, ref)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr"]
+
+
+#: 1200 designs on the per-variant path in 200 chunks: a second or two of work
+_INTERRUPTED_STUDY = """
+[[parameters]]
+path = "mount_rings[0].count"
+values = [3, 4, 5, 6]
+[[parameters]]
+path = "mount_rings[0].k_shear"
+values = { start = 5e3, stop = 5e4, num = 300, scale = "log" }
+"""
+
+
+_CLI = "import sys; from impstab.cli import main; sys.exit(main(sys.argv[1:]))"
+#: the command line, with every chunk left to the workers once the cluster has started
+_CLI_DASK_ONLY = ("import sys; from impstab.studies import distributed; "
+                  "distributed.ClusterStart.ready = lambda self: self.wait() or True; " + _CLI.split("; ", 1)[1])
+
+
+@pytest.fixture(scope="module")
+def interrupted(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("sigint")
+    study = write_study(folder, _INTERRUPTED_STUDY, chunk_size=6)
+    run_study(load_study(study), folder / "ref.zarr")
+    return study, folder / "ref.zarr"
+
+
+@pytest.mark.parametrize("where,after", [("in-process", 3), ("dask", 3), ("dask", 0)],
+                         ids=["in-process", "dask-mid-run", "dask-while-the-cluster-starts"])
+def test_ctrl_c_in_a_terminal_ends_in_one_line_and_resumes(tmp_path, interrupted, where, after):
+    """SIGINT to the whole foreground process group, as a terminal's Ctrl-C sends it (to the
+    local workers too): exit 130, one line on stderr, and a store that resumes to the
+    uninterrupted run's (or none, if no chunk was finished)."""
+    study, ref = interrupted
+    store = tmp_path / "s.zarr"
+    args = ["sweep", str(study), "-o", str(store), "--no-progress"]
+    if where == "dask":
+        args += ["--workers", "2", "--min-dask-designs", "0"]
+    cmd = [sys.executable, "-c", _CLI_DASK_ONLY if after else _CLI, *args]
+    env = dict(os.environ, PYTHONPATH=str(SRC), MPLBACKEND="Agg")
+    with subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env,
+                          start_new_session=True) as proc:
+        deadline = time.time() + 120
+        while time.time() < deadline and proc.poll() is None and not (store.exists() and _records_done(store) >= after):
+            time.sleep(0.005)  # after=0: the store is made, the cluster is starting
+        assert proc.poll() is None, "the run ended before it could be interrupted"
+        os.killpg(proc.pid, signal.SIGINT)
+        err = proc.communicate(timeout=120)[1]
+    assert proc.returncode == 130, err
+    assert len(err.strip().splitlines()) == 1 and "interrupted" in err, err
+    if store.exists():
+        run_study(load_study(study), store, report=lambda line: None)
+        assert_same_store(store, ref)
+        history = json.loads(open_study(store).dataset.attrs["history"])
+        assert history[0]["interrupted"] is True
+    else:
+        assert "nothing was" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) in ([], ["s.zarr"])

@@ -137,12 +137,17 @@ def run_study(
             say(line)
         return _run(study, plan, st, workers, scheduler, client, owned, progress, say, in_process_below)
     except BaseException:
+        _close(owned)  # the workers stopped first: nothing writes into the store any more
         st.discard()  # a store made by this run with no chunk finished: nothing to resume, nothing left
         raise
     finally:
         st.close()
-        for s in owned:
-            s.close()
+        _close(owned)
+
+
+def _close(owned: list) -> None:
+    while owned:
+        owned.pop().close()
 
 
 def _run(study, plan, st: StudyStore, workers, scheduler, client, owned: list, progress: bool, say,

@@ -424,10 +424,12 @@ class StudyStore:
     def discard(self) -> bool:
         """Remove the store if this run made it and finished no chunk in it (nothing to resume)."""
         self.close()
-        if self.created and self.path is not None and not self._done.any():
-            shutil.rmtree(self.path, ignore_errors=True)
-            return True
-        return False
+        if not (self.created and self.path is not None) or self._done.any():
+            return False
+        if any(self.files.read(record_key(i)) is not None for i in range(self.plan.n_chunks)):
+            return False  # a chunk finished by a worker that this process had not heard of yet
+        shutil.rmtree(self.path, ignore_errors=True)
+        return True
 
     def __enter__(self) -> "StudyStore":
         return self
