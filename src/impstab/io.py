@@ -31,19 +31,24 @@ from typing import Any, BinaryIO, Callable, Iterator
 from .errors import ModelError
 
 __all__ = [
-    "OutputError", "write_output", "write_netcdf", "save_figure", "write_csv", "check_output",
+    "PathError", "OutputError", "write_output", "write_netcdf", "save_figure", "write_csv", "check_output",
     "atomic_path", "owner_tag", "is_stale", "remove_stale", "describe_os_error", "pid_alive",
 ]
 
 
-class OutputError(ModelError):
-    """An output that cannot be written: ``option = 'path': cannot be written: reason``."""
+class PathError(ModelError):
+    """A ModelError about a file or folder: ``option = 'path': rule``, with the whole path."""
 
-    def __init__(self, option: str, path: str | os.PathLike[str], reason: str) -> None:
-        super().__init__(option, str(path), reason)
+    def __init__(self, option: str, path: str | os.PathLike[str], rule: str) -> None:
+        super().__init__(option, str(path), rule)
+        self.args = (f"{option} = {str(path)!r}: {rule}",)  # the whole path, however long
 
     def __reduce__(self):  # picklable (raised on Dask workers, re-raised by the client)
         return (type(self), (self.field, self.value, self.rule))
+
+
+class OutputError(PathError):
+    """An output that cannot be written: ``option = 'path': cannot be written: reason``."""
 
 
 _REASONS = {

@@ -19,15 +19,14 @@ import os
 import socket
 from pathlib import Path
 
-from ..errors import ModelError
-from ..io import output_error, pid_alive
+from ..io import PathError, output_error, pid_alive
 
 __all__ = ["RunLock", "LOCK_NAME", "StoreLockedError"]
 
 LOCK_NAME = ".impstab-lock"
 
 
-class StoreLockedError(ModelError):
+class StoreLockedError(PathError):
     """Another run writes the store."""
 
 
@@ -56,7 +55,7 @@ class RunLock:
 
         path = self.path
         if path.is_symlink():
-            raise ModelError(self.field, str(self.root), f"holds a symbolic link, {path}: remove it")
+            raise PathError(self.field, self.root, f"holds a symbolic link, {path}: remove it")
         try:
             fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
         except OSError as exc:
@@ -69,13 +68,13 @@ class RunLock:
             if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
                 os.close(fd)
                 raise StoreLockedError(
-                    self.field, str(self.root),
+                    self.field, self.root,
                     f"is being written by another impstab run ({_holder_text(path)}): wait for it to end, "
                     "or stop it and run again",
                 ) from None
             if not self._holder_gone(path):  # no flock on this file system: judge the holder named in the file
                 os.close(fd)
-                raise StoreLockedError(self.field, str(self.root),
+                raise StoreLockedError(self.field, self.root,
                                        f"is locked by {_holder_text(path)}: wait for it to end, or stop it") from None
         holder = {"pid": os.getpid(), "host": socket.gethostname(),
                   "started": _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()}

@@ -327,6 +327,7 @@ def open_study(store: str | os.PathLike[str]) -> StudyResult:
     """
     import xarray as xr
 
+    from ..io import PathError
     from .store import read_store, tidy
     from .store_files import FolderFiles
 
@@ -335,11 +336,11 @@ def open_study(store: str | os.PathLike[str]) -> StudyResult:
         try:
             ds = xr.load_dataset(p, engine="h5netcdf")
         except Exception as exc:  # noqa: BLE001 - any unreadable file is "not a study"
-            raise ModelError("STORE", str(p), f"cannot be read as netCDF ({type(exc).__name__})") from None
+            raise PathError("STORE", p, f"cannot be read as netCDF ({type(exc).__name__})") from None
         if not str(ds.attrs.get("format", "")).startswith("impstab-study-store"):
-            raise ModelError("STORE", str(p), "is not an export of an impstab study")
+            raise PathError("STORE", p, "is not an export of an impstab study")
         return StudyResult(tidy(ds), None)
     if not p.is_dir():
-        raise ModelError("STORE", str(p), "is not a folder (give the zarr store written by 'impstab sweep', or its .nc export)")
+        raise PathError("STORE", p, "is not a folder (give the zarr store written by 'impstab sweep', or its .nc export)")
     view = read_store(FolderFiles(p, "STORE"), str(p), field="STORE")
     return StudyResult(view.dataset, str(p), tuple(view.pending))

@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ModelError
-from ..io import output_error, owner_tag, remove_stale
+from ..io import PathError, output_error, owner_tag, remove_stale
 from .evaluate import ChunkResult
 from .lock import RunLock
 from .plan import ChunkPlan
@@ -223,14 +223,14 @@ class StudyStore:
     @classmethod
     def _resume(cls, study, plan, path: Path, field: str, files_ref: dict, root: dict) -> "StudyStore":
         if not path.is_dir():
-            raise ModelError(field, str(path), "exists and is not an impstab study store (give a new path)")
+            raise PathError(field, path, "exists and is not an impstab study store (give a new path)")
         files = FolderFiles(path, field)
         findings = [_stale_note(p) for p in remove_stale(path.parent, f".{path.name}.creating-")]
         try:
             disk_root = json_doc(files.read("zarr.json"))
             progress = json_doc(files.read("progress/zarr.json"))
         except OSError as exc:
-            raise ModelError(field, str(path), f"cannot be read: {exc.strerror or exc}") from None
+            raise PathError(field, path, f"cannot be read: {exc.strerror or exc}") from None
         intact = disk_root is not None and root_intact(disk_root)
         _identify(study, path, field, disk_root, intact, progress)
         try:
@@ -446,22 +446,22 @@ def _identify(study: Study, path: Path, field: str, root, intact: bool, progress
     fmt = attrs.get("format")
     if intact:
         if fmt != FORMAT:
-            raise ModelError(field, str(path), "exists and is not an impstab study store (give a new path)")
+            raise PathError(field, path, "exists and is not an impstab study store (give a new path)")
         if attrs.get("fingerprint") != study.fingerprint:
-            raise ModelError(field, str(path),
+            raise PathError(field, path,
                              "holds a different study (the study file or its base model changed since it was "
                              "started): give a new path or remove it")
         if attrs.get("impstab_version") != __version__:
-            raise ModelError(field, str(path),
+            raise PathError(field, path,
                              f"was started with impstab {attrs.get('impstab_version')}, this is {__version__}: "
                              "finish it with that version or start a new store")
         return
     if isinstance(fmt, str) and fmt.startswith("impstab-study-store/") and fmt != FORMAT and INTEGRITY not in attrs:
-        raise ModelError(field, str(path), f"was written in an older store format ({fmt}, without checksums): "
+        raise PathError(field, path, f"was written in an older store format ({fmt}, without checksums): "
                                            "finish it with the impstab version that started it, or start a new store")
     if attrs.get("fingerprint") == study.fingerprint or attributes(progress).get("fingerprint") == study.fingerprint:
         return  # ours, with damaged metadata: repaired from the study
     if root is None and progress is None:
-        raise ModelError(field, str(path), "exists and is not an impstab study store (give a new path)")
-    raise ModelError(field, str(path), "exists, but its metadata are damaged and do not name this study: "
+        raise PathError(field, path, "exists and is not an impstab study store (give a new path)")
+    raise PathError(field, path, "exists, but its metadata are damaged and do not name this study: "
                                        "give a new path, or remove it to start again")

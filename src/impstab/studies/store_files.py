@@ -18,12 +18,12 @@ import secrets
 import stat
 from pathlib import Path
 
-from ..errors import ModelError
+from ..io import PathError
 
 __all__ = ["StoreFiles", "FolderFiles", "MemoryFiles", "StoreLinkError", "scan"]
 
 
-class StoreLinkError(ModelError):
+class StoreLinkError(PathError):
     """A symbolic link inside a study store (refused: nothing is written through it)."""
 
     def __init__(self, field: str, store: str, link: str) -> None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 
-from ..errors import ModelError
+from ..io import PathError
 from .plan import ChunkPlan
 from .records import check_chunk, file_checksum, record_key
 from .store_files import StoreFiles
@@ -59,7 +59,7 @@ def read_store(files: StoreFiles, name: str, field: str = "STORE", data: bool = 
     try:
         root_bytes = files.read("zarr.json")
     except OSError as exc:
-        raise ModelError(field, name, f"cannot be read: {exc.strerror or exc}") from None
+        raise PathError(field, name, f"cannot be read: {exc.strerror or exc}") from None
     root = json_doc(root_bytes)
     attrs = attributes(root)
     fmt = attrs.get("format")
@@ -67,15 +67,15 @@ def read_store(files: StoreFiles, name: str, field: str = "STORE", data: bool = 
         ours = "fingerprint" in attributes(json_doc(files.read("progress/zarr.json")))
         if ours or (root_bytes is not None and "consolidated_metadata" not in (root or {})):
             state = "missing" if root_bytes is None else "damaged"
-            raise ModelError(field, name, f"its metadata (zarr.json) are {state}" + ("" if ours else
+            raise PathError(field, name, f"its metadata (zarr.json) are {state}" + ("" if ours else
                                           " or it is not an impstab study store") + ": run the study again "
                                           "(impstab sweep STUDY -o STORE) to repair them")
-        raise ModelError(field, name, "is not an impstab study store")
+        raise PathError(field, name, "is not an impstab study store")
     if fmt != FORMAT:
-        raise ModelError(field, name, f"was written in an older store format ({fmt}) that cannot be verified: "
+        raise PathError(field, name, f"was written in an older store format ({fmt}) that cannot be verified: "
                                       "read it with the impstab version that made it")
     if not root_intact(root):
-        raise ModelError(field, name, "its metadata (zarr.json) do not match their checksum: run the study again "
+        raise PathError(field, name, "its metadata (zarr.json) do not match their checksum: run the study again "
                                       "(impstab sweep STUDY -o STORE) to repair them")
     meta = root["consolidated_metadata"]["metadata"]
     prog = meta["progress"]["attributes"]
@@ -105,9 +105,9 @@ def read_store(files: StoreFiles, name: str, field: str = "STORE", data: bool = 
             else:
                 view.update(got)
     except OSError as exc:
-        raise ModelError(field, name, f"cannot be read: {exc.strerror or exc}") from None
+        raise PathError(field, name, f"cannot be read: {exc.strerror or exc}") from None
     if damaged:
-        raise ModelError(field, name, f"holds damaged data, which do not match their checksums: {names(damaged)}; "
+        raise PathError(field, name, f"holds damaged data, which do not match their checksums: {names(damaged)}; "
                                       "run the study again (impstab sweep STUDY -o STORE) to compute them again")
     proto = default_buffer_prototype().buffer
     mem = zarr.storage.MemoryStore(store_dict={k: proto.from_bytes(v) for k, v in view.items() if v is not None})
