@@ -207,12 +207,7 @@ def start_local(workers: int) -> Session:
     """A local cluster of ``workers`` processes and its client."""
     from distributed import Client
 
-    try:
-        import bokeh  # noqa: F401
-
-        dashboard = ":0"
-    except ImportError:
-        dashboard = None
+    dashboard = ":0"  # a free port: the dashboard with bokeh, else Dask's HTTP routes (never the busy 8787)
     owned: list = []
     try:
         with _silent(interrupt_after=True):
