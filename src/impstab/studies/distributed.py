@@ -122,6 +122,8 @@ def local_cluster(n_workers: int, **kwargs):
 
     kw = dict(threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL)
     kw.update(kwargs)
+    if kw.get("dashboard_address", ":8787") is None:  # no dashboard: Dask's HTTP routes on a free port, not 8787
+        kw["scheduler_kwargs"] = {"dashboard": False, "dashboard_address": ":0", **kw.get("scheduler_kwargs", {})}
     with dask.config.set({**_QUIET_CLUSTER, **_fork_server()}):
         return LocalCluster(n_workers=n_workers, **kw)
 
