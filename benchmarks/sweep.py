@@ -18,27 +18,35 @@ Measured in one run on this machine:
 * **coupled** -- the same measurement of sweep and loop on a layout with no decoupled blocks
   (the asymmetric example, classical linearization, over the first mount's x and shear
   stiffness), so that the figure for designs the block route cannot help is in the same line.
-* **workers** -- the same study on a ``dask.distributed.LocalCluster`` of 1 and 2 worker
-  processes (one thread each), cluster started and warmed up (one chunk on every worker)
-  before the clock starts; the fastest of ``--repeat`` runs counts (the timeit convention),
-  and every run's time is printed. Then the same on a larger grid of the same study
-  (``--scale-n``, default 300 x 300 = 9e4 designs), where the fixed costs of a run (store
-  creation, first dispatch, last write: some 60 ms) no longer weigh on a 0.3 s map. For the
-  2-worker runs, the CPU time of this process (client, scheduler, store writes) and of the
-  workers: on two cores this process competes with the workers. Beside it, the machine's own
-  parallelism: the same CPU-bound loop in 1 and then 2 processes at once (on a machine whose
-  two cores do not run two processes at full speed, no program scales).
+* **workers** -- the same study on a local Dask cluster (``impstab.studies.execute.local_cluster``)
+  of each of ``--workers-list`` worker processes (default 1, 2, 4, 8; one thread each; the
+  workers write their own chunks), cluster started and warmed up (one chunk on every worker)
+  before the clock starts; the fastest of ``--repeat`` runs counts (the timeit convention), and
+  every run's time is printed, with the parallel efficiency rate(n) / (n rate(1)) and its bound
+  cores / n on a machine with fewer cores than workers. Then the same on a larger grid of the
+  same study (``--scale-n``, default 317 x 317 = 1e5 designs; ``--scale-n 1000`` for 1e6), where
+  the fixed costs of a run no longer weigh, and there, end to end as the command line runs it,
+  ``run_study`` in process against ``run_study(workers=2)`` with the cluster's start, warm-up and
+  shutdown included. For the 2-worker runs, the CPU time of this process (client, scheduler) and
+  of the workers. Beside it, the machine's own parallelism: the same CPU-bound loop in 1 and then
+  2 processes at once (on a machine whose two cores do not run two processes at full speed, no
+  program scales). The scaling figure on a bigger machine is one command::
+
+      python benchmarks/sweep.py --no-coupled --scale-n 1000 --workers-list 1,2,4,8,16 --repeat 2
 
 Ends with one JSON line:
-``{"designs_per_s", "speedup_vs_loop", "lapack_fraction", "workers_scaling": {"1", "2"}, ...}``,
-with ``workers_scaling_at_scale`` (``designs``, ``"1"``, ``"2"``, ``client_cpu_share_2``,
-``workers_cpu_s``) among the extra keys.
+``{"designs_per_s", "speedup_vs_loop", "lapack_fraction", "workers_scaling": {"1", "2", "4", "8"}, ...}``,
+with ``parallel_efficiency`` (per worker count), ``workers_scaling_at_scale`` (``designs``, the
+rates, ``parallel_efficiency``, ``cores``, ``client_cpu_share_2``, ``workers_cpu_s``) and
+``workers_2_end_to_end`` (``designs``, ``in_process_s``, ``workers_2_s``, ``speedup``) among the
+extra keys.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import tempfile
 import time
@@ -127,7 +135,7 @@ def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng) -> dict:
 
 def timed_study(study, store: Path, **kw) -> tuple[float, object]:
     t0 = time.perf_counter()
-    res = run_study(study, store, **kw)
+    res = run_study(study, store, report=lambda line: None, **kw)
     return time.perf_counter() - t0, res
 
 
@@ -162,7 +170,7 @@ def worker_runs(study, tmp: Path, n_workers: int, repeats: int) -> dict:
 
     Returns the rate of the fastest run (designs/s, the timeit convention: the others were
     slowed by something else), every run's seconds, and the CPU seconds of that run in this
-    process (client and scheduler) and in the workers.
+    process (client and scheduler) and in the workers. The workers write the chunks.
     """
     from distributed import Client
 
@@ -173,7 +181,8 @@ def worker_runs(study, tmp: Path, n_workers: int, repeats: int) -> dict:
         client.run(evaluate_chunk, chunk_task(study, plan_chunks(study), 0))
         for r in range(repeats):
             workers0, client0 = client.run(_cpu_seconds), time.process_time()
-            seconds, _ = timed_study(study, tmp / f"w{n_workers}-{study.size}-{r}.zarr", client=client)
+            seconds, _ = timed_study(study, tmp / f"w{n_workers}-{study.size}-{r}.zarr", client=client,
+                                     in_process_below=0)
             client_cpu = time.process_time() - client0
             workers1 = client.run(_cpu_seconds)
             runs.append((seconds, client_cpu, sum(workers1[w] - workers0[w] for w in workers0)))
@@ -181,20 +190,47 @@ def worker_runs(study, tmp: Path, n_workers: int, repeats: int) -> dict:
     return {"rate": study.size / best[0], "seconds": [r[0] for r in runs], "client_cpu": best[1], "workers_cpu": best[2]}
 
 
-def scaling(study, tmp: Path, repeats: int) -> tuple[dict, dict]:
-    """Designs/s on 1 and 2 workers (best runs), and the CPU shares of the 2-worker run."""
+def scaling(study, tmp: Path, repeats: int, counts: list[int]) -> tuple[dict, dict]:
+    """Designs/s on each number of workers (best runs), the parallel efficiency, the CPU shares.
+
+    The efficiency of n workers is rate(n) / (n rate(1)): 1.0 is linear speed-up. On a machine
+    with fewer cores than workers it cannot exceed cores / n; that bound is printed beside it.
+    """
     out, runs = {}, {}
-    for w in (1, 2):
+    cores = os.cpu_count() or 1
+    for w in counts:
         runs[w] = worker_runs(study, tmp, w, repeats)
         out[str(w)] = runs[w]["rate"]
-        print(f"dask {w} worker{'s' if w > 1 else ' '}   {runs[w]['rate']:,.0f} designs/s on {study.size} designs "
+        print(f"dask {w:2d} worker{'s' if w > 1 else ' '}  {runs[w]['rate']:,.0f} designs/s on {study.size} designs "
               f"(best of {' '.join(f'{t:.2f}' for t in runs[w]['seconds'])} s; workers' CPU {runs[w]['workers_cpu']:.2f} s)")
-    two = runs[2]
-    share = two["client_cpu"] / (two["client_cpu"] + two["workers_cpu"])
-    print(f"worker scaling   {out['2'] / out['1']:.2f}x from 1 to 2 workers; in the 2-worker run this process "
-          f"(client, scheduler, store writes) used {two['client_cpu']:.2f} s of CPU, the workers {two['workers_cpu']:.2f} s "
-          f"({share:.0%} on this process)")
-    return out, {"client_cpu_share_2": share, "workers_cpu_s": {str(w): runs[w]["workers_cpu"] for w in runs}}
+    one = out.get("1")
+    efficiency = {str(w): out[str(w)] / (w * one) for w in counts} if one else {}
+    if efficiency:
+        print("efficiency       " + ", ".join(f"{w} workers {efficiency[str(w)]:.2f} (at most {min(1.0, cores / w):.2f} "
+                                              f"on {cores} cores)" for w in counts if w > 1))
+    extra = {"parallel_efficiency": efficiency, "cores": cores,
+             "workers_cpu_s": {str(w): runs[w]["workers_cpu"] for w in runs}}
+    if 2 in runs:
+        two = runs[2]
+        share = two["client_cpu"] / (two["client_cpu"] + two["workers_cpu"])
+        extra["client_cpu_share_2"] = share
+        print(f"client           in the 2-worker run this process (client, scheduler) used {two['client_cpu']:.2f} s of "
+              f"CPU, the workers {two['workers_cpu']:.2f} s ({share:.0%} on this process)")
+    return out, extra
+
+
+def end_to_end(study, tmp: Path, repeats: int, workers: int = 2) -> dict:
+    """``run_study`` in process against ``run_study(workers=N)`` as the command line runs them:
+    cluster start, worker warm-up and shutdown included (best of ``repeats`` each)."""
+    local, dask = [], []
+    for r in range(repeats):
+        local.append(timed_study(study, tmp / f"e2e-local-{r}.zarr")[0])
+        dask.append(timed_study(study, tmp / f"e2e-dask-{r}.zarr", workers=workers, in_process_below=0)[0])
+    ratio = min(local) / min(dask)
+    print(f"end to end       {study.size} designs: in process {min(local):.2f} s, --workers {workers} {min(dask):.2f} s "
+          f"(cluster start included): {ratio:.2f}x")
+    return {"designs": study.size, "in_process_s": min(local), f"workers_{workers}_s": min(dask),
+            "speedup": ratio}
 
 
 def main() -> int:
@@ -205,8 +241,11 @@ def main() -> int:
     ap.add_argument("--loop-sample", type=int, default=500, help="designs timed in the plain loop")
     ap.add_argument("--no-workers", action="store_true", help="skip the Dask worker scaling")
     ap.add_argument("--repeat", type=int, default=3, help="runs per worker count; the fastest counts (default 3)")
-    ap.add_argument("--scale-n", type=int, default=300,
-                    help="grid points per parameter of the larger study for the scaling at scale (default 300, 0 skips)")
+    ap.add_argument("--scale-n", type=int, default=317,
+                    help="grid points per parameter of the larger study for the scaling at scale (default 317: "
+                         "1e5 designs; 1000 for 1e6; 0 skips)")
+    ap.add_argument("--workers-list", default="1,2,4,8",
+                    help="worker counts to measure, comma-separated (default 1,2,4,8)")
     ap.add_argument("--no-coupled", action="store_true", help="skip the coupled-layout measurement")
     args = ap.parse_args()
     rng = np.random.default_rng(0)
@@ -240,14 +279,18 @@ def main() -> int:
             coupled = coupled_rates(tmp, args.n, args.chunk, args.loop_sample, rng)
             print(f"coupled layout   {coupled['designs_per_s']:,.0f} designs/s, loop {coupled['loop_us_per_design']:.0f} "
                   f"us/design: {coupled['speedup_vs_loop']:.2f}x (asymmetric example, no decoupled blocks)")
-        workers, at_scale, parallel = {}, {}, None
+        workers, at_scale, parallel, e2e = {}, {}, None, {}
         if not args.no_workers:
-            workers, _ = scaling(study, tmp, args.repeat)
+            counts = sorted({int(w) for w in args.workers_list.split(",") if w.strip()})
+            workers, extra = scaling(study, tmp, args.repeat, counts)
+            workers_efficiency = extra["parallel_efficiency"]
             if args.scale_n:
                 big = tmp / "study_large.toml"
                 big.write_text(STUDY.format(model=EXAMPLE.as_posix(), n=args.scale_n, chunk=args.chunk, **RING))
-                at_scale, shares = scaling(load_study(big), tmp, max(1, args.repeat - 1))
-                at_scale = {"designs": args.scale_n**2, **at_scale, **shares}
+                large = load_study(big)
+                at_scale, shares = scaling(large, tmp, max(1, args.repeat - 1), counts)
+                at_scale = {"designs": large.size, **at_scale, **shares}
+                e2e = end_to_end(large, tmp, max(1, args.repeat - 1))
             parallel = machine_parallelism()
             print(f"machine          runs 2 CPU-bound processes {parallel:.2f}x as fast as 1")
     line = {
@@ -260,8 +303,12 @@ def main() -> int:
         "loop_timed_on": len(subset),
         "eigenproblems_per_design": evaluations / n,
     }
+    if workers:
+        line["parallel_efficiency"] = workers_efficiency
     if at_scale:
         line["workers_scaling_at_scale"] = at_scale
+    if e2e:
+        line["workers_2_end_to_end"] = e2e
     if parallel is not None:
         line["machine_parallelism_2_processes"] = parallel
     if coupled:

@@ -289,24 +289,24 @@ def test_returned_results_equal_the_store_read_back(tmp_path, body):
 
 def test_results_of_a_fresh_run_come_from_the_written_chunks(tmp_path):
     # the assembled values are the chunk results themselves: remove a variable's chunks from
-    # disk after the writes, and the loaded dataset still holds them (read back: the fill value)
+    # disk after the writes, and the loaded dataset still holds them, while a reader of the
+    # store refuses it, naming the missing chunks
+    from impstab.errors import ModelError
     from impstab.studies.evaluate import evaluate_chunk
     from impstab.studies.execute import chunk_task
     from impstab.studies.store import StudyStore
 
     study = load_study(write_study(tmp_path, GRID_6x5, chunk_size=8))
     plan = plan_chunks(study)
-    st = StudyStore.create_or_resume(study, plan, tmp_path / "s.zarr")
-    results = [evaluate_chunk(chunk_task(study, plan, i)) for i in range(plan.n_chunks)]
-    for r in results:
-        st.write(r)
-    for chunk in (tmp_path / "s.zarr" / "critical_thrust" / "c").rglob("*"):
-        if chunk.is_file():
-            chunk.unlink()
-    assert np.isnan(st.open_dataset()["critical_thrust"].values).all()
-    ds = st.load_dataset()
+    with StudyStore.create_or_resume(study, plan, tmp_path / "s.zarr") as st:
+        results = [evaluate_chunk(chunk_task(study, plan, i)) for i in range(plan.n_chunks)]
+        for r in results:
+            st.write(r)
+        for chunk in (tmp_path / "s.zarr" / "critical_thrust" / "c").rglob("*"):
+            if chunk.is_file():
+                chunk.unlink()
+        ds = st.load_dataset()
     for r in results:
         np.testing.assert_array_equal(ds["critical_thrust"].values[plan.slices(r.index)], r.data["critical_thrust"])
-    # a store this object only resumed is read back
-    again = StudyStore.create_or_resume(study, plan, tmp_path / "s.zarr")
-    assert np.isnan(again.load_dataset()["critical_thrust"].values).all()
+    with pytest.raises(ModelError, match=r"chunk 0 \(critical_thrust/c/0/0 missing\)"):
+        open_study(tmp_path / "s.zarr")

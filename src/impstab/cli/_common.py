@@ -11,6 +11,7 @@ from typing import Any
 import click
 
 from ..errors import ModelError, NumericalError, printable
+from ..io import check_output  # noqa: F401  (re-exported for the commands)
 
 __all__ = ["run_guarded", "print_json", "jsonable", "BadInput", "console", "check_number", "table", "TextTable", "fmt",
            "figure_options", "data_and_figure", "draw_and_save", "user_text", "at_thrust", "check_output"]
@@ -145,7 +146,7 @@ def data_and_figure(out, data_suffixes: tuple[str, ...], figure: str | None, no_
             raise ModelError("--no-plot", True, f"contradicts the figure output {out}")
         if figure is not None:
             raise ModelError("--figure", figure, f"give either -o {out} (a figure) or --figure, not both")
-        check_output("--output", out)
+        check_output(out, option="--output")
         return None, out
     if suffix not in data_suffixes:
         allowed = ", ".join(data_suffixes + FIGURE_FORMATS)
@@ -155,8 +156,8 @@ def data_and_figure(out, data_suffixes: tuple[str, ...], figure: str | None, no_
             raise ModelError("--figure", figure, "contradicts --no-plot")
         return out, None
     fig = check_figure_path(figure, "--figure") if figure is not None else out.with_suffix(".png")
-    check_output("--output", out)
-    check_output("--figure" if figure is not None else "--output", fig)
+    check_output(out, option="--output")
+    check_output(fig, option="--figure" if figure is not None else "--output")
     return out, fig
 
 
@@ -214,28 +215,6 @@ def at_thrust(option: str, thrust: float, model, compute):
                                              f"at {crit.thrust:.6g} N ({crit.kind}) and its mounts do not carry "
                                              "this thrust") from None
         raise
-
-
-def check_output(option: str, path: object) -> None:
-    """An output path must be a new file or a regular file: a FIFO, a device, a socket or a
-    folder of that name would be replaced by the rename that writes the output."""
-    import os
-    import stat
-
-    try:
-        mode = os.lstat(os.fspath(path)).st_mode  # type: ignore[arg-type]
-    except FileNotFoundError:
-        return
-    except (OSError, ValueError):
-        return  # unreadable parent or odd name: the write itself reports it with the path
-    if stat.S_ISLNK(mode):
-        try:
-            mode = os.stat(os.fspath(path)).st_mode  # type: ignore[arg-type]
-        except OSError:
-            return
-    if not stat.S_ISREG(mode):
-        kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file (a pipe, a device or a socket)"
-        raise ModelError(option, str(path), f"exists and is {kind}: give the name of a file to write")
 
 
 def user_text(value: object) -> str:

@@ -145,7 +145,7 @@ def added_mass_cmd(radius: float, length: float, density: float, sound_speed: fl
 
         check_figure_path(output)
     if output is not None:
-        check_output("--output", output)
+        check_output(output, option="--output")
     check_number("--dpi", dpi, kind="dpi")
     grid = parse_frequencies(frequencies, MAX_FREQUENCIES * (LONG_FACTOR if allow_long else 1))
     # validate the geometry and the work before a long sweep starts
@@ -164,10 +164,9 @@ def added_mass_cmd(radius: float, length: float, density: float, sound_speed: fl
     sweep = _with_flag_names(fluid.frequency_sweep, radius, length, grid, density, sound_speed,
                              progress=_progress)
     if output is not None and output.lower().endswith(".nc"):
-        from ..io import atomic_path
+        from ..io import write_netcdf
 
-        with atomic_path(output) as tmp:
-            sweep.to_xarray().to_netcdf(tmp, engine="h5netcdf")
+        write_netcdf(sweep.to_xarray(), output, option="--output")
     elif output is not None:
         _save_figure(sweep, output, dpi)
     if as_json:

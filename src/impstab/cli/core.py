@@ -219,7 +219,7 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
 def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearization: str | None, output: str | None,
               figure: str | None, dpi: float | None, no_plot: bool) -> None:
     """Eigenvalue loci against thrust: netCDF data and a figure like the paper's Figure 4."""
-    from ..io import atomic_path
+    from ..io import check_output, write_netcdf
     from ..linear.locus import locus
 
     thrust_max = check_number("--thrust-max", thrust_max, kind="thrust")
@@ -228,6 +228,9 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
     out = Path(output) if output else Path(Path(model_file).stem + "-locus.nc")
     data, fig_path = data_and_figure(out, (".nc",), figure, no_plot, dpi)
     model = _load(model_file)
+    for path in (data, fig_path):
+        if path is not None:
+            check_output(path, option="--output")
     try:
         res = locus(model, steps=steps, thrust_max=thrust_max, linearization=linearization, critical=True)
     except ModelError as exc:
@@ -235,8 +238,7 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
             raise
         raise ModelError("--thrust-max" if thrust_max is not None else "analysis.thrust_max", exc.value, exc.rule) from None
     if data is not None:
-        with atomic_path(data) as tmp:
-            res.to_xarray().to_netcdf(tmp, engine="h5netcdf")
+        write_netcdf(res.to_xarray(), data, option="--output")
     if fig_path is not None:
         draw_and_save(res.plot, fig_path, dpi)
     con = console()

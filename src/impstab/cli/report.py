@@ -80,7 +80,7 @@ def report_cmd(ctx: click.Context, model_or_store: str, output: str | None, sect
     check_number("--duration", duration, kind="duration")
     from ._common import check_output
 
-    check_output("--output", out)
+    check_output(out, option="--output")
     check_number("--target-margin", target_margin, positive=True)
     chosen = None
     if sections is not None:

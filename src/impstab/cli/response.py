@@ -87,14 +87,16 @@ def _excitation_tables(ex) -> None:
 
 
 def _write(out: Path, res, ex, plot: bool) -> list[Path]:
-    from ..io import atomic_path
+    from ..io import save_figure, write_output
 
     written = []
     if out.suffix.lower() == ".nc":
-        with atomic_path(out) as tmp:
-            res.to_xarray().to_netcdf(tmp, engine="h5netcdf")
+        def netcdf(buf) -> None:
+            res.to_xarray().to_netcdf(buf, engine="h5netcdf")
             if ex is not None:
-                ex.to_xarray().to_netcdf(tmp, mode="a", group="excitation", engine="h5netcdf")
+                ex.to_xarray().to_netcdf(buf, mode="a", group="excitation", engine="h5netcdf")
+
+        write_output(out, netcdf, option="--output")
         written.append(out)
     if plot:
         import matplotlib
@@ -111,9 +113,10 @@ def _write(out: Path, res, ex, plot: bool) -> list[Path]:
             fig, axes = plt.subplots(2, 1, figsize=(9.0, 8.4), layout="constrained")
             res.plot(ax=axes[0])
             ex.plot(ax=axes[1])
-        with atomic_path(png) as tmp:
-            fig.savefig(tmp, format="png", dpi=120)
-        plt.close(fig)
+        try:
+            save_figure(fig, png, option="--output", dpi=120)
+        finally:
+            plt.close(fig)
         written.append(png)
     return written
 
@@ -144,8 +147,8 @@ def response_cmd(model_file: str, spec: str, thrust: float | None, dof: str | No
     if out is not None and out.suffix.lower() not in (".nc", ".png"):
         raise ModelError("--output", output, "must end in .nc (netCDF; a PNG is written beside it) or .png")
     if out is not None:
-        check_output("--output", out)
-        check_output("--output", out.with_suffix(".png"))
+        check_output(out, option="--output")
+        check_output(out.with_suffix(".png"), option="--output")
     model = load_model(model_file)
     t_lin = thrust if thrust is not None else (model.thrust.operating or 0.0)
     res = at_thrust("--thrust", t_lin, model,

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import click
 
@@ -30,12 +29,9 @@ def schema_cmd(study: bool, markdown: bool, output: str | None) -> None:
         click.echo(text, nl=False)
         return
     from ..errors import printable
-    from ..io import atomic_path
-    from ._common import check_output
+    from ..io import write_output
 
-    check_output("--output", output)
-    with atomic_path(output) as tmp:
-        Path(tmp).write_text(text, encoding="utf-8")
+    write_output(output, text.encode("utf-8"), option="--output")
     click.echo(f"wrote {printable(output)}", err=True)
 
 

@@ -99,14 +99,12 @@ def _draw(results):
 
 def _write(results, out: Path) -> None:
     from ..dynamics.result import combine_results, results_to_dataframe
-    from ..io import atomic_path
+    from ..io import write_csv, write_netcdf
 
-    with atomic_path(out) as tmp:
-        if out.suffix.lower() == ".csv":
-            results_to_dataframe(results).to_csv(tmp, index=False)
-        else:
-            ds = results[0].to_xarray() if len(results) == 1 else combine_results(results)
-            ds.to_netcdf(tmp, engine="h5netcdf")
+    if out.suffix.lower() == ".csv":
+        write_csv(results_to_dataframe(results), out, option="--output", index=False)
+    else:
+        write_netcdf(results[0].to_xarray() if len(results) == 1 else combine_results(results), out, option="--output")
 
 
 def _table(results, model_name: str):
@@ -177,6 +175,11 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     if displace or kick:
         pert = {"displacement": _dof_values("--displace", displace), "velocity": _dof_values("--kick", kick)}
     model = load_model(model_file)
+    from ..io import check_output
+
+    for path in (data, fig_path):
+        if path is not None:
+            check_output(path, option="--output")  # before the run, not after it
     crit = critical_thrust(model, linearization="equilibrium").thrust
     steps = {v: at_thrust("--thrusts" if thrusts else "--thrust", v, model, lambda v=v: default_step(model, v))
              for v in values}

@@ -79,7 +79,7 @@ def stats_cmd(store: str, target_margin: float | None, confidence: float, no_sen
     check_number("--dpi", dpi, kind="dpi")
     out = check_figure_path(output) if output else None
     if out is not None:
-        check_output("--output", out)
+        check_output(out, option="--output")
     res = open_study(store)
     kw = {"confidence": confidence, "sensitivity": not no_sensitivity}
     try:

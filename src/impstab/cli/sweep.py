@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from pathlib import Path
@@ -37,31 +38,49 @@ def _fmt(v, unit: str = "") -> str:
 @click.option("--export", "exports", multiple=True, type=click.Path(dir_okay=False),
               help="also write the results to FILE.nc (netCDF) or FILE.csv; may be repeated")
 @click.option("--progress/--no-progress", default=None, help="progress bar (default: when the terminal shows one)")
+@click.option("--min-dask-designs", type=int, default=None,
+              help="fewer designs to compute (or fewer than 2 chunks per worker) run in process even with "
+                   "--workers/--scheduler; default 20000, 0: always on Dask")
 def sweep_cmd(study_file: str, store: str | None, workers: int | None, scheduler: str | None,
-              exports: tuple[str, ...], progress: bool | None) -> None:
+              exports: tuple[str, ...], progress: bool | None, min_dask_designs: int | None) -> None:
     """Run the design study STUDY_FILE (or resume it) into a zarr store."""
+    try:
+        _sweep(study_file, store, workers, scheduler, exports, progress, min_dask_designs)
+    except KeyboardInterrupt:  # before the run started (reading the study, starting Dask)
+        raise Interrupted("interrupted; nothing was computed") from None
+
+
+def _sweep(study_file: str, store: str | None, workers: int | None, scheduler: str | None,
+           exports: tuple[str, ...], progress: bool | None, min_dask_designs: int | None) -> None:
     from ..studies import load_study, run_study
+    from ..studies.execute import IN_PROCESS_BELOW, MAX_WORKERS
 
     if workers is not None and scheduler is not None:
         raise ModelError("--workers", workers, "give either --workers or --scheduler, not both")
-    if workers is not None and not 1 <= workers <= _max_workers():
-        raise ModelError("--workers", workers, f"must be between 1 and {_max_workers()} (4 per CPU core of this machine)")
+    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+        raise ModelError("--workers", workers, f"must be between 1 and {MAX_WORKERS} (4 per CPU core of this machine, at least 8)")
+    if min_dask_designs is not None and min_dask_designs < 0:
+        raise ModelError("--min-dask-designs", min_dask_designs, "must be >= 0")
     for path in exports:
         if Path(path).suffix.lower() not in _EXPORTS:
             raise ModelError("--export", path, "must end in .nc (netCDF) or .csv")
-        check_output("--export", path)
+        check_output(path, option="--export")
     study = load_study(study_file)
     out = Path(store) if store else Path(Path(study_file).stem + ".zarr")
     if progress is None:
         progress = sys.stderr.isatty()
     t0 = time.perf_counter()
     try:
-        res = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress)
+        res = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress,
+                        report=lambda line: click.echo(f"impstab: note: {line}", err=True),
+                        in_process_below=IN_PROCESS_BELOW if min_dask_designs is None else min_dask_designs)
     except KeyboardInterrupt:
+        if not out.exists():
+            raise Interrupted("interrupted before the first chunk was finished; nothing was kept") from None
         raise Interrupted(f"interrupted; the chunks finished so far are kept in {out}: "
                           "run the same command again to resume") from None
     elapsed = time.perf_counter() - t0
-    written = [str(res.export(p)) for p in exports]
+    written = [str(res.export(p, option="--export")) for p in exports]
     _summary(res, study, out, elapsed, written)
 
 
@@ -73,6 +92,9 @@ def _summary(res, study, out: Path, elapsed: float, written: list[str]) -> None:
     t.add_row("parameters", user_text("; ".join(f"{p.name}: {label(p.name)}" for p in study.parameters)))
     t.add_row("designs", ", ".join(f"{k} {v}" for k, v in counts.items() if v or k == "ok"))
     t.add_row("time (this run)", f"{elapsed:.3g} s")
+    history = json.loads(res.dataset.attrs.get("history", "[]"))
+    if history:
+        t.add_row("run", f"{history[-1].get('executor', '')}; {history[-1].get('chunks_computed', 0)} chunks computed")
     if counts["ok"]:
         for by, u in (("margin", ""), ("critical_thrust", "N")):
             if by in res.dataset:
@@ -93,12 +115,6 @@ def _summary(res, study, out: Path, elapsed: float, written: list[str]) -> None:
         first = res.dataset["message"].values[failed][0]
         click.echo(f"impstab: {int(failed.sum())} designs failed (see 'status' and 'message'); first: {printable(first)}",
                    err=True)
-
-
-def _max_workers() -> int:
-    import os
-
-    return 4 * (os.cpu_count() or 1)
 
 
 def _parse_at(items: tuple[str, ...]) -> dict[str, object]:
@@ -131,9 +147,15 @@ def map_cmd(store: str, x: str | None, y: str | None, value: str, at: tuple[str,
 
     out = Path(output) if output else Path(str(Path(store)).rstrip("/\\").removesuffix(".zarr") + "-map.png")
     check_figure_path(out)
-    check_output("--output", out)
+    check_output(out, option="--output")
     check_number("--dpi", dpi, kind="dpi")
     res = open_study(store)
+    if res.pending_chunks:
+        n = res.dataset.attrs.get("n_chunks", "?")
+        shown = ", ".join(str(i) for i in res.pending_chunks[:8]) + (" ..." if len(res.pending_chunks) > 8 else "")
+        click.echo(f"impstab: warning: {len(res.pending_chunks)} of {n} chunks of {store} are not computed yet "
+                   f"(chunks {shown}): their designs are left blank; run 'impstab sweep' on the study again "
+                   "to finish them", err=True)
     draw_and_save(lambda: res.plot(x=x, y=y, value=value, at=_parse_at(at)), out, dpi)
     console().print(f"wrote {user_text(out)}")
 

@@ -24,15 +24,16 @@ def check_figure_path(path: str | os.PathLike[str], flag: str = "--output") -> P
 
 def save_figure(fig, path: str | os.PathLike[str], dpi: float | None = None, flag: str = "--output") -> Path:
     """Write ``fig`` to ``path`` (format from the suffix; ``dpi`` for PNG, default
-    :data:`DEFAULT_DPI`); a temporary name is renamed on success, so no partial file is left."""
-    from ..io import atomic_path
+    :data:`DEFAULT_DPI`); rendered in memory and written whole (:func:`impstab.io.write_output`),
+    so no partial file is left and a full disk is one line naming ``flag``."""
+    from ..io import write_output
 
     p = check_figure_path(path, flag)
     if dpi is not None and not (dpi > 0 and dpi <= 2400):
         raise ModelError("--dpi", dpi, "must be between 1 and 2400")
-    with figure_style(), atomic_path(p) as tmp:
-        fig.savefig(tmp, format=p.suffix.lower().lstrip("."), dpi=dpi or DEFAULT_DPI,
-                    metadata=_metadata(p.suffix.lower()))
+    with figure_style():
+        write_output(p, lambda buf: fig.savefig(buf, format=p.suffix.lower().lstrip("."), dpi=dpi or DEFAULT_DPI,
+                                                metadata=_metadata(p.suffix.lower())), option=flag)
     return p
 
 

@@ -3,27 +3,51 @@
 In process (the default) the chunks run one after the other in this process, each one a batch
 of designs through the batched engine, with a rich progress bar (rate and ETA). ``workers=N``
 starts a local Dask cluster of N single-threaded worker processes; ``scheduler=ADDRESS`` uses an
-existing ``dask.distributed`` cluster. Either way the workers receive one chunk's parameter
-values at a time and send back that chunk's results; this process writes them to the store, so
-the workers need no access to it. Rerunning an interrupted study computes only the chunks that
-are not marked done.
+existing ``dask.distributed`` cluster (:mod:`impstab.studies.distributed`): each worker writes
+the chunks it computes into the store itself, and this process only schedules. While a local
+cluster starts (seconds: its workers' imports and first compiled calls), this process computes
+the first chunks itself, so that the start costs the run little.
+
+**Small studies stay in process.** Starting a local cluster costs some 2 s of CPU on two cores
+and each task some milliseconds of scheduling, so a run on Dask pays only when there is enough
+to share: fewer than
+:data:`IN_PROCESS_BELOW` designs to compute, or fewer than two chunks per worker, run in this
+process, and the run's history and output say so.
+
+Rerunning an interrupted study computes only the chunks that are not verified done
+(:mod:`impstab.studies.store`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
-import threading
-from typing import Callable, Iterator
+from typing import Callable
 
 from ..errors import ModelError
-from .evaluate import ChunkResult, ChunkTask, evaluate_chunk
+from ..io import output_error
+from .evaluate import ChunkTask, evaluate_chunk
 from .plan import ChunkPlan, plan_chunks
 from .result import StudyResult
 from .store import StudyStore
 from .study import Study
 
-__all__ = ["run_study", "chunk_task", "local_cluster"]
+__all__ = ["run_study", "chunk_task", "local_cluster", "IN_PROCESS_BELOW", "MAX_WORKERS"]
+
+#: designs to compute below which a run asked to use Dask stays in this process
+IN_PROCESS_BELOW = 20_000
+#: most local worker processes for ``workers=N`` (per CPU core, and at least)
+MAX_WORKERS = max(8, 4 * (os.cpu_count() or 1))
+
+_log = logging.getLogger("impstab.studies")
+
+
+def local_cluster(n_workers: int, **kwargs):
+    """A local Dask cluster for studies (see :func:`impstab.studies.distributed.local_cluster`)."""
+    from .distributed import local_cluster as _local
+
+    return _local(n_workers, **kwargs)
 
 
 def chunk_task(study: Study, plan: ChunkPlan, index: int) -> ChunkTask:
@@ -47,6 +71,8 @@ def run_study(
     scheduler: str | None = None,
     client=None,
     progress: bool = False,
+    report: Callable[[str], None] | None = None,
+    in_process_below: int = IN_PROCESS_BELOW,
 ) -> StudyResult:
     """Run (or resume) ``study`` and return its results.
 
@@ -55,8 +81,9 @@ def run_study(
     study : Study
         From :func:`impstab.studies.load_study`.
     store : path, optional
-        zarr store (a folder). Created if missing; if it exists it must hold the same study,
-        and only the chunks not yet done are computed. None keeps the results in memory.
+        zarr store (a folder). Created if missing; if it exists it must hold the same study: it
+        is verified, and only the chunks not done (or found damaged) are computed. None keeps
+        the results in memory.
     workers : int, optional
         Start a local Dask cluster with this many worker processes (one thread each).
     scheduler : str, optional
@@ -65,41 +92,142 @@ def run_study(
         An already connected Dask client (takes precedence over ``workers`` and ``scheduler``).
     progress : bool
         Show a progress bar (rich in process, Dask's own on a cluster).
+    report : callable, optional
+        Receives one line for each thing the run found and did besides computing (a damaged
+        chunk computed again, a repaired file, the choice to stay in process); default: the
+        ``impstab.studies`` logger, level WARNING.
+    in_process_below : int
+        A run on Dask with fewer designs to compute (or fewer than two chunks per worker)
+        stays in this process; 0 never does.
 
     Returns
     -------
     StudyResult
+
+    Raises
+    ------
+    ModelError
+        Bad arguments, a store of another study or written by another run, a scheduler that
+        does not answer (before anything is written), a store that cannot be written
+        (:class:`impstab.io.OutputError`: the chunks finished so far are kept).
+    KeyboardInterrupt
+        Ctrl-C: the chunks finished so far are kept, the run is marked interrupted.
     """
     if workers is not None and scheduler is not None:
         raise ModelError("--workers", workers, "give either --workers or --scheduler, not both")
-    if workers is not None and not (isinstance(workers, int) and workers >= 1):
-        raise ModelError("--workers", workers, "must be a whole number >= 1")
+    if workers is not None and not (isinstance(workers, int) and not isinstance(workers, bool)
+                                    and 1 <= workers <= MAX_WORKERS):
+        raise ModelError("--workers", workers, f"must be a whole number from 1 to {MAX_WORKERS}")
+    say = report or _log.warning
     plan = plan_chunks(study)
-    st = StudyStore.create_or_resume(study, plan, store)
-    todo = [i for i, d in enumerate(st.done()) if not d]
+    session = None
+    if client is None and scheduler is not None:
+        from .distributed import connect
+
+        session = connect(scheduler)  # before anything is written: a wrong address leaves nothing behind
+    try:
+        st = StudyStore.create_or_resume(study, plan, store)
+    except BaseException:
+        if session is not None:
+            session.close()
+        raise
+    owned = [session] if session is not None else []
+    try:
+        for line in st.findings:
+            say(line)
+        return _run(study, plan, st, workers, scheduler, client, owned, progress, say, in_process_below)
+    except BaseException:
+        _close(owned)  # the workers stopped first: nothing writes into the store any more
+        st.discard()  # a store made by this run with no chunk finished: nothing to resume, nothing left
+        raise
+    finally:
+        st.close()
+        _close(owned)
+
+
+def _close(owned: list) -> None:
+    while owned:
+        owned.pop().close()
+
+
+def _run(study, plan, st: StudyStore, workers, scheduler, client, owned: list, progress: bool, say,
+         in_process_below: int) -> StudyResult:
+    session = owned[0] if owned else None
+    todo = st.todo()
+    designs = sum(_prod(plan.block_shape(i)) for i in todo)
+    asked = client is not None or workers is not None or scheduler is not None
+    where = "in-process"
+    if asked and todo:
+        n_workers = workers if workers is not None else _worker_count(client or session.client)
+        if in_process_below and (designs < in_process_below or len(todo) < 2 * n_workers):
+            where = (f"in-process: {designs} designs in {len(todo)} chunks to compute, too few to share among "
+                     f"{n_workers} workers (Dask is used from {in_process_below} designs and 2 chunks per worker)")
+            say(where)
+            asked = False
     computed = [0]
 
-    def write(res: ChunkResult) -> None:
-        st.write(res)
+    def done(index: int) -> None:
         computed[0] += 1
 
-    tasks = (chunk_task(study, plan, i) for i in todo)
-    sizes = {i: _prod(plan.block_shape(i)) for i in todo}
-    on_dask = client is not None or workers is not None or scheduler is not None
-    where = "in-process"
-    if on_dask:
-        where = "dask: " + (scheduler or ("a connected client" if client is not None else f"local cluster of {workers} workers"))
-    run = st.begin_run(where)
-    interrupted = True
+    dask = asked and bool(todo)
+    label = ""
+    if dask:
+        label = scheduler or ("a connected client" if client is not None else f"local cluster of {workers} workers")
+    run = None
     try:
-        if todo and on_dask:
-            _run_dask(tasks, write, workers, scheduler, client, progress, study.fingerprint)
+        run = st.begin_run(f"dask: {label}" if dask else where)
+        if dask:
+            from .distributed import ClusterStart, run_on_dask
+
+            early = 0
+            if client is None and session is None:  # compute here while the local cluster starts
+                start = ClusterStart(workers)
+                owned.append(start)
+                rest = _run_local(study, plan, st, todo, done, progress, until=start.ready)
+                early, todo = len(todo) - len(rest), rest
+                session = start.wait()
+                if session is None:
+                    say(f"the local Dask cluster did not start ({type(start.error).__name__}: {start.error}); "
+                        "the study goes on in this process")
+                    _run_local(study, plan, st, todo, done, progress)
+                    todo = []
+            how = "this process computed every chunk"
+            if todo:
+                how = run_on_dask(client if client is not None else session.client, st, study, plan, todo, done,
+                                  progress)
+            if early:
+                how += f"; this process computed {early} chunks while the cluster started"
+            st.set_executor(run, f"dask: {label} ({how})")
         elif todo:
-            _run_local(tasks, sizes, write, progress)
-        interrupted = False
-    finally:
-        st.end_run(run, computed[0], interrupted)
+            _run_local(study, plan, st, todo, done, progress)
+    except KeyboardInterrupt:
+        _end(st, run, computed[0], interrupted=True)
+        raise
+    except OSError as exc:
+        _end(st, run, computed[0], error=str(exc))
+        kept = int(st.done().sum())
+        raise output_error("--output", st.path or "memory", exc,
+                           f"{kept} of {plan.n_chunks} chunks are done and kept: make room, then run the same "
+                           "command again to resume" if kept else "no chunk was finished") from None
+    except BaseException as exc:
+        _end(st, run, computed[0], error=f"{type(exc).__name__}: {exc}")
+        raise
+    _end(st, run, computed[0])
     return StudyResult.from_store(st)
+
+
+def _end(st: StudyStore, run, computed: int, interrupted: bool = False, error: str | None = None) -> None:
+    if run is None:
+        return
+    with contextlib.suppress(OSError):  # a full disk: the history entry stays open, the chunks are kept
+        st.end_run(run, computed, interrupted, error)
+
+
+def _worker_count(client) -> int:
+    try:
+        return max(1, len(client.scheduler_info().get("workers", {})))
+    except Exception:  # noqa: BLE001 - a count for the small-study rule only
+        return 1
 
 
 def _prod(shape) -> int:
@@ -109,11 +237,16 @@ def _prod(shape) -> int:
     return out
 
 
-def _run_local(tasks: Iterator[ChunkTask], sizes: dict[int, int], write: Callable, progress: bool) -> None:
+def _run_local(study: Study, plan: ChunkPlan, st: StudyStore, todo: list[int], done: Callable, progress: bool,
+               until: Callable[[], bool] | None = None) -> list[int]:
+    """Compute and write the chunks ``todo`` here, in order, until ``until()`` is true; return the rest."""
+    stop = until or (lambda: False)
+    rest = list(todo)
     if not progress:
-        for task in tasks:
-            write(evaluate_chunk(task))
-        return
+        while rest and not stop():
+            st.write(evaluate_chunk(chunk_task(study, plan, rest[0])))
+            done(rest.pop(0))
+        return rest
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, ProgressColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
     from rich.text import Text
@@ -125,125 +258,11 @@ def _run_local(tasks: Iterator[ChunkTask], sizes: dict[int, int], write: Callabl
 
     columns = (TextColumn("designs"), BarColumn(), MofNCompleteColumn(), Rate(), TimeElapsedColumn(),
                TextColumn("ETA"), TimeRemainingColumn())
-    with Progress(*columns, console=Console(stderr=True)) as bar:
-        job = bar.add_task("designs", total=sum(sizes.values()))
-        for task in tasks:
-            res = evaluate_chunk(task)
-            write(res)
-            bar.advance(job, sizes[task.index])
-
-
-def _worker_version() -> str:
-    try:
-        from impstab import __version__
-
-        return __version__
-    except Exception as exc:  # noqa: BLE001 - reported to the user
-        return f"cannot import impstab ({type(exc).__name__}: {exc})"
-
-
-#: Dask settings of the clusters started here (see :func:`local_cluster`)
-_QUIET_CLUSTER = {
-    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
-    "distributed.worker.profile.enabled": False,
-    "distributed.admin.tick.interval": "1s",
-    "distributed.admin.system-monitor.interval": "2s",
-}
-
-
-def local_cluster(n_workers: int, **kwargs):
-    """A ``dask.distributed.LocalCluster`` of single-threaded worker processes for studies.
-
-    Dask's nannies start workers with ``MALLOC_TRIM_THRESHOLD_=65536``; setting it turns off
-    glibc's adaptive mmap threshold, so that every temporary array above 128 kB is mapped and
-    unmapped anew and its pages faulted in again: a chunk of designs then takes 1.5x as long.
-    The workers started here go without it (the batched engine's temporaries are freed at the
-    end of each chunk). They also go without Dask's background work that a study does not
-    use: the statistical profiler that samples each worker's thread every 10 ms (some 4 % of
-    a worker's time), the 20 ms event-loop tick (it only warns of a blocked loop) and the
-    0.5 s system monitor (the dashboard's CPU and memory plots, every 2 s here). On two cores
-    that background took a tenth of a core. Other keyword arguments go to ``LocalCluster``.
-    """
-    import dask
-    from distributed import LocalCluster
-
-    kw = dict(threads_per_worker=1, processes=True, silence_logs=logging.ERROR)
-    kw.update(kwargs)
-    with dask.config.set(_QUIET_CLUSTER):
-        return LocalCluster(n_workers=n_workers, **kw)
-
-
-def _connect(workers: int | None, scheduler: str | None):
-    """A client, and the objects to close afterwards."""
-    from distributed import Client
-
-    if scheduler is not None:
-        try:
-            client = Client(scheduler, timeout="20s")
-        except (OSError, TimeoutError) as exc:
-            raise ModelError("--scheduler", scheduler, f"no Dask scheduler answered there ({exc})") from None
-        return client, [client]
-    try:
-        import bokeh  # noqa: F401
-
-        dashboard = ":0"
-    except ImportError:
-        dashboard = None
-    cluster = local_cluster(workers, dashboard_address=dashboard)
-    client = Client(cluster)
-    return client, [client, cluster]
-
-
-def _run_dask(tasks, write: Callable, workers, scheduler, client, progress: bool, token: str) -> None:
-    from distributed import as_completed
-
-    from .. import __version__
-
-    owned: list = []
-    if client is None:
-        client, owned = _connect(workers, scheduler)
-    try:
-        for worker, version in client.run(_worker_version).items():
-            if version != __version__:
-                raise ModelError("--scheduler", worker, f"this worker has impstab {version}, the client {__version__}: install the same version everywhere")
-        futures = [
-            client.submit(evaluate_chunk, t, key=f"impstab-chunk-{token[:12]}-{t.index}", pure=False, retries=2)
-            for t in tasks
-        ]
-        keys = [f.key for f in futures]
-        bar = _dask_progress(client, futures) if progress else None
-        pending = as_completed(futures)
-        del futures
-        held: list = []
-        try:
-            for fut in pending:
-                write(fut.result())
-                # results are released once written, after Dask's bar has seen every task
-                held.append(fut)
-                if bar is None or hasattr(bar, "_last_response"):
-                    for f in held:
-                        f.release()
-                    held.clear()
-        except BaseException:
-            client.cancel(keys)
-            raise
-    finally:
-        for obj in owned:
-            obj.close()
-
-
-def _dask_progress(client, futures: list):
-    """Dask's own progress bar: a text bar in a terminal, a widget in a notebook."""
-    from distributed.diagnostics.progressbar import TextProgressBar
-    from distributed.utils import is_kernel
-
-    if is_kernel():
-        from distributed import progress
-        from IPython.display import display
-
-        widget = progress(futures, notebook=True)
-        display(widget)
-        return widget
-    bar = TextProgressBar(futures, scheduler=client.scheduler.address, start=False)
-    threading.Thread(target=bar._loop_runner.run_sync, args=(bar.listen,), daemon=True).start()
-    return bar
+    with Progress(*columns, console=Console(stderr=True), transient=until is not None) as bar:
+        job = bar.add_task("designs", total=sum(_prod(plan.block_shape(i)) for i in todo))
+        while rest and not stop():
+            index = rest.pop(0)
+            st.write(evaluate_chunk(chunk_task(study, plan, index)))
+            done(index)
+            bar.advance(job, _prod(plan.block_shape(index)))
+    return rest

@@ -27,10 +27,14 @@ class StudyResult:
         model, the package version and timestamps in ``attrs``.
     store : str or None
         Where the results are stored (None for an in-memory study).
+    pending_chunks : tuple of int
+        The chunks not computed yet (their designs have status -1 and fill values): an
+        interrupted study read before it was resumed.
     """
 
     dataset: Any
     store: str | None = None
+    pending_chunks: tuple[int, ...] = ()
 
     def __repr__(self) -> str:
         from ..display import study_text
@@ -58,7 +62,8 @@ class StudyResult:
 
     @classmethod
     def from_store(cls, st) -> "StudyResult":
-        return cls(st.load_dataset(), None if st.path is None else str(st.path))
+        return cls(st.load_dataset(), None if st.path is None else str(st.path),
+                   tuple(int(i) for i in (~st.done()).nonzero()[0]))
 
     # -- views --------------------------------------------------------------------------------
     @property
@@ -245,17 +250,18 @@ class StudyResult:
         return plot_stability_map(self, ax=ax, x=x, y=y, value=value, at=at)
 
     # -- exports ------------------------------------------------------------------------------
-    def to_netcdf(self, path: str | os.PathLike[str]) -> Path:
-        """Write the results to a netCDF file (written to a temporary name, then renamed)."""
-        from ..io import atomic_path
+    def to_netcdf(self, path: str | os.PathLike[str], *, option: str = "path") -> Path:
+        """Write the results to a netCDF file, whole or not at all (:func:`impstab.io.write_output`).
 
-        with atomic_path(path) as tmp:
-            self.dataset.to_netcdf(tmp, engine="h5netcdf")
-        return Path(path)
+        ``option`` names the path in the error message (``--export`` on the command line).
+        """
+        from ..io import write_netcdf
 
-    def to_csv(self, path: str | os.PathLike[str]) -> Path:
+        return write_netcdf(self.dataset, path, option=option)
+
+    def to_csv(self, path: str | os.PathLike[str], *, option: str = "path") -> Path:
         """Write one row per design (parameters, outputs, status, message) to a CSV file."""
-        from ..io import atomic_path
+        from ..io import write_csv
 
         ds = self.dataset
         frame = ds.to_dataframe().reset_index()
@@ -265,18 +271,16 @@ class StudyResult:
                 frame[v] = names[frame[v].to_numpy().astype(int)]
         first = [c for c in ("sample", *self.parameters) if c in frame.columns]
         frame = frame[first + [c for c in frame.columns if c not in first]]
-        with atomic_path(path) as tmp:
-            frame.to_csv(tmp, index=False)
-        return Path(path)
+        return write_csv(frame, path, option=option, index=False)
 
-    def export(self, path: str | os.PathLike[str]) -> Path:
+    def export(self, path: str | os.PathLike[str], *, option: str = "--export") -> Path:
         """Write to ``.nc`` (netCDF) or ``.csv`` by the file's extension."""
         suffix = Path(path).suffix.lower()
         if suffix == ".nc":
-            return self.to_netcdf(path)
+            return self.to_netcdf(path, option=option)
         if suffix == ".csv":
-            return self.to_csv(path)
-        raise ModelError("--export", str(path), "must end in .nc (netCDF) or .csv")
+            return self.to_csv(path, option=option)
+        raise ModelError(option, str(path), "must end in .nc (netCDF) or .csv")
 
 
 def _best_warning(by: str, value: float, bound: bool, tied: int, left_out: int, floor: float) -> str | None:
@@ -311,30 +315,32 @@ def _base_value(attrs: dict, section: str, key: str):
 def open_study(store: str | os.PathLike[str]) -> StudyResult:
     """Load the results of a study: its zarr store (complete or not) or a netCDF export.
 
+    A store is verified first (:func:`impstab.studies.store.read_store`): only data that match
+    their completion records are read. Chunks not computed yet (an interrupted study) are
+    returned with status -1 and listed in ``pending_chunks``.
+
     Raises
     ------
     ModelError
-        If ``store`` is neither.
+        If ``store`` is neither, or the store holds damaged data (the chunks and files are named;
+        rerunning the study computes them again).
     """
     import xarray as xr
 
-    from .store import tidy
+    from ..io import PathError
+    from .store import read_store, tidy
+    from .store_files import FolderFiles
 
     p = Path(store)
     if p.is_file() and p.suffix.lower() == ".nc":
         try:
             ds = xr.load_dataset(p, engine="h5netcdf")
         except Exception as exc:  # noqa: BLE001 - any unreadable file is "not a study"
-            raise ModelError("STORE", str(p), f"cannot be read as netCDF ({type(exc).__name__})") from None
+            raise PathError("STORE", p, f"cannot be read as netCDF ({type(exc).__name__})") from None
         if not str(ds.attrs.get("format", "")).startswith("impstab-study-store"):
-            raise ModelError("STORE", str(p), "is not an export of an impstab study")
+            raise PathError("STORE", p, "is not an export of an impstab study")
         return StudyResult(tidy(ds), None)
     if not p.is_dir():
-        raise ModelError("STORE", str(p), "is not a folder (give the zarr store written by 'impstab sweep', or its .nc export)")
-    try:
-        ds = xr.open_zarr(str(p), consolidated=None, chunks=None)
-    except Exception as exc:  # noqa: BLE001 - any unreadable folder is "not a store"
-        raise ModelError("STORE", str(p), f"cannot be read as a zarr store ({type(exc).__name__})") from None
-    if not str(ds.attrs.get("format", "")).startswith("impstab-study-store"):
-        raise ModelError("STORE", str(p), "is not an impstab study store")
-    return StudyResult(tidy(ds).load(), str(p))
+        raise PathError("STORE", p, "is not a folder (give the zarr store written by 'impstab sweep', or its .nc export)")
+    view = read_store(FolderFiles(p, "STORE"), str(p), field="STORE")
+    return StudyResult(view.dataset, str(p), tuple(view.pending))
