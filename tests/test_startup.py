@@ -1,5 +1,5 @@
-"""Start-up: the command table against the command modules, and what `--help`, `--version`,
-`import impstab` and `critical --json` import."""
+"""Start-up: the command table against the command modules, what `--help`, `--version`,
+`import impstab` and `critical --json` import, and the numba cache folder and its key."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import importlib
 import json
 import os
 import pkgutil
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -15,6 +16,7 @@ import pytest
 
 import impstab
 import impstab.cli as cli_pkg
+from impstab import _numba_cache
 from impstab.cli import COMMANDS, cli, main, short_help
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -105,7 +107,7 @@ def test_import_impstab_is_cheap_and_names_stay_public():
         capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(SRC)}, timeout=120,
     )
     assert res.returncode == 0, res.stderr
-    assert eval(res.stdout) == ["impstab.errors"]
+    assert eval(res.stdout) == ["impstab._numba_cache", "impstab.errors"]
     for name in impstab.__all__:
         assert getattr(impstab, name) is not None, name
     assert set(impstab.__all__) <= set(dir(impstab))
@@ -121,3 +123,65 @@ def test_critical_json_imports_no_plotting_tables_or_stores(examples):
     heavy = [m for m in ("matplotlib", "xarray", "dask", "zarr", "rich", "scipy.optimize", "h5py", "pandas")
              if m in loaded]
     assert heavy == []
+
+
+# -- the numba cache ------------------------------------------------------------------------------
+def _package_copy(tmp_path: Path) -> Path:
+    dest = tmp_path / "impstab"
+    shutil.copytree(Path(impstab.__file__).parent, dest, ignore=shutil.ignore_patterns("__pycache__"))
+    return dest
+
+
+def test_key_follows_kernel_sources_and_their_imports(tmp_path):
+    pkg = _package_copy(tmp_path)
+    sources = _numba_cache.kernel_sources(pkg)
+    names = {p.relative_to(pkg).as_posix() for p in sources}
+    users = {p.relative_to(pkg).as_posix() for p in pkg.rglob("*.py")
+             if _numba_cache._USES_NUMBA.search(p.read_bytes())}
+    assert users and users <= names  # every module that imports numba
+    key = _numba_cache.source_key(pkg)
+    assert _numba_cache.source_key(pkg) == key  # deterministic
+    # a module no kernel reaches (a command): editing it keeps the compiled code
+    (pkg / "cli" / "schema.py").write_text((pkg / "cli" / "schema.py").read_text() + "\n# edit\n")
+    assert "cli/schema.py" not in names and _numba_cache.source_key(pkg) == key
+    # a kernel's own file
+    kernel = pkg / sorted(users)[0]
+    kernel.write_text(kernel.read_text() + "\n# edit\n")
+    key2 = _numba_cache.source_key(pkg)
+    assert key2 != key
+    # a plain module whose constant a kernel module imports (numba freezes it into the code),
+    # reached through a package __init__ that re-exports it
+    (pkg / "constants_only.py").write_text("LIMIT = 1.0\n")
+    (pkg / "reexport").mkdir()
+    (pkg / "reexport" / "__init__.py").write_text("from ..constants_only import LIMIT\n")
+    (pkg / "kernel_user.py").write_text("from numba import njit\nfrom .reexport import (\n    LIMIT,\n)\n")
+    key3 = _numba_cache.source_key(pkg)
+    assert {"constants_only.py", "reexport/__init__.py", "kernel_user.py"} <= {
+        p.relative_to(pkg).as_posix() for p in _numba_cache.kernel_sources(pkg)}
+    (pkg / "constants_only.py").write_text("LIMIT = 2.0\n")
+    assert _numba_cache.source_key(pkg) not in (key, key2, key3)
+
+
+def test_numba_cache_folder_is_outside_the_sources_and_the_users_setting_wins(tmp_path):
+    code = ("import os, impstab, numba.core.config as c; import impstab.linear.small_eig as k; "
+            "print(os.environ.get('NUMBA_CACHE_DIR')); print(c.CACHE_DIR)")
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", _numba_cache.SET_BY_IMPSTAB)}
+    env["PYTHONPATH"] = str(SRC)
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+    assert res.returncode == 0, res.stderr
+    env_dir, config_dir = res.stdout.split()
+    assert env_dir == config_dir == str(_numba_cache.cache_root() / "numba" / _numba_cache.source_key())
+    assert not Path(env_dir).is_relative_to(SRC)
+    own = tmp_path / "own"
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env={**env, "NUMBA_CACHE_DIR": str(own)}, timeout=300)
+    assert res.stdout.split() == [str(own), str(own)]
+    # inherited from an impstab process (a worker): computed again, not taken as the user's own
+    stale = str(tmp_path / "parent")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env={**env, "NUMBA_CACHE_DIR": stale, _numba_cache.SET_BY_IMPSTAB: stale}, timeout=300)
+    assert res.stdout.split() == [env_dir, env_dir]
+    # numba imported before impstab: the folder still applies to impstab's kernels
+    res = subprocess.run([sys.executable, "-c", "import numba; " + code], capture_output=True, text=True, env=env,
+                         timeout=300)
+    assert res.stdout.split() == [env_dir, env_dir]

@@ -12,7 +12,10 @@ frequency ``omega`` (rad/s); ``frequency_hz = omega / 2 pi``.
 
 from __future__ import annotations
 
+from . import _numba_cache
 from .errors import ModelError, NumericalError
+
+_numba_cache.install()  # compiled kernels cached outside the source tree (see impstab._numba_cache)
 
 __all__ = [
     "__version__", "load_model", "Model", "linearize", "LinearSystem", "modes", "critical_thrust",
