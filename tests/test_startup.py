@@ -137,8 +137,9 @@ def test_key_follows_kernel_sources_and_their_imports(tmp_path):
     sources = _numba_cache.kernel_sources(pkg)
     names = {p.relative_to(pkg).as_posix() for p in sources}
     users = {p.relative_to(pkg).as_posix() for p in pkg.rglob("*.py")
-             if _numba_cache._USES_NUMBA.search(p.read_bytes())}
-    assert users and users <= names  # every module that imports numba
+             if _numba_cache.is_kernel_module(p.read_bytes())}
+    assert users and users <= names  # every module that defines kernels
+    assert "precompile.py" not in names  # imports numba to find the kernels, defines none
     key = _numba_cache.source_key(pkg)
     assert _numba_cache.source_key(pkg) == key  # deterministic
     # a module no kernel reaches (a command): editing it keeps the compiled code
@@ -154,7 +155,8 @@ def test_key_follows_kernel_sources_and_their_imports(tmp_path):
     (pkg / "constants_only.py").write_text("LIMIT = 1.0\n")
     (pkg / "reexport").mkdir()
     (pkg / "reexport" / "__init__.py").write_text("from ..constants_only import LIMIT\n")
-    (pkg / "kernel_user.py").write_text("from numba import njit\nfrom .reexport import (\n    LIMIT,\n)\n")
+    (pkg / "kernel_user.py").write_text("from numba import njit\nfrom .reexport import (\n    LIMIT,\n)\n\n\n"
+                                        "@njit(cache=True)\ndef scaled(x):\n    return LIMIT * x\n")
     key3 = _numba_cache.source_key(pkg)
     assert {"constants_only.py", "reexport/__init__.py", "kernel_user.py"} <= {
         p.relative_to(pkg).as_posix() for p in _numba_cache.kernel_sources(pkg)}
@@ -185,3 +187,41 @@ def test_numba_cache_folder_is_outside_the_sources_and_the_users_setting_wins(tm
     res = subprocess.run([sys.executable, "-c", "import numba; " + code], capture_output=True, text=True, env=env,
                          timeout=300)
     assert res.stdout.split() == [env_dir, env_dir]
+
+
+# -- the precompile step ---------------------------------------------------------------------------
+@pytest.mark.parametrize("from_examples", [True, False])
+def test_precompile_cases_are_valid_command_lines(tmp_path, monkeypatch, from_examples):
+    from impstab import precompile
+    from impstab.model import load_model
+
+    if not from_examples:  # an installed package: no examples beside it, models written instead
+        monkeypatch.setattr(precompile, "EXAMPLES", tmp_path / "missing")
+    todo = precompile.cases(tmp_path)
+    commands = {argv[0] for _, argv in todo}
+    assert {"critical", "simulate", "response", "sweep", "locus"} <= commands <= set(COMMANDS)
+    for label, argv in todo:
+        command = cli.commands[argv[0]]
+        command.make_context(argv[0], list(argv[1:]))  # options and arguments parse
+        model = Path(argv[1])
+        assert model.is_file(), label
+        if model.name.startswith("imp_"):
+            load_model(model)
+        elif argv[0] == "sweep":
+            impstab.load_study(model)
+    if not from_examples:
+        assert all(Path(argv[1]).is_relative_to(tmp_path) for _, argv in todo)
+
+
+def test_precompile_stops_at_a_complete_cache_and_keeps_the_users_own(tmp_path, monkeypatch, capsys):
+    from impstab import precompile
+
+    own = tmp_path / "own"
+    own.mkdir()
+    (own / precompile.MARKER).write_text("done\n")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(own))
+    monkeypatch.delenv(_numba_cache.SET_BY_IMPSTAB, raising=False)
+    assert precompile.main(["--quiet"]) == 0
+    assert "already compiled" in capsys.readouterr().out
+    assert precompile.main(["--clean"]) == 0
+    assert "not removed" in capsys.readouterr().out and (own / precompile.MARKER).is_file()
