@@ -68,21 +68,47 @@ def _models(folder: Path) -> dict[str, Path]:
     return out
 
 
-def _studies(folder: Path, model: Path) -> dict[str, Path]:
-    """The study files of the cases: the examples, else a 3 x 2 grid written into ``folder``."""
+_GRID = """schema_version = 1
+name = "precompile: {name}"
+model = {model!r}
+outputs = ["critical_thrust", "kind", "frequency_hz", "margin", "undamped_critical_thrust", "modes"]
+[[parameters]]
+path = "{first}"
+values = {values}
+[[parameters]]
+path = "{second}"
+values = {second_values}
+[sampling]
+method = "grid"
+"""
+
+
+def _studies(folder: Path, models: dict[str, Path]) -> dict[str, Path]:
+    """The study files of the cases: the examples (else a small grid on the symmetric model), a
+    grid with unrestrained designs among valid ones, and one on the asymmetric model."""
+    out = {}
     if (EXAMPLES / "study_mounts.toml").is_file():
-        return {p.stem.removeprefix("study_"): p for p in sorted(EXAMPLES.glob("study_*.toml"))}
-    study = folder / "study_grid.toml"
-    study.write_text(
-        "schema_version = 1\nname = \"precompile\"\n"
-        f"model = {str(model.resolve())!r}\n"
-        'outputs = ["critical_thrust", "kind", "frequency_hz", "margin", "undamped_critical_thrust", "modes"]\n'
-        '[[parameters]]\npath = "mount_rings[0].x"\nvalues = { start = 0.1, stop = 0.4, num = 3 }\n'
-        '[[parameters]]\npath = "mount_rings[0].k_shear"\nvalues = { start = 1.0e4, stop = 3.0e4, num = 2 }\n'
-        '[sampling]\nmethod = "grid"\n',
-        encoding="utf-8",
-    )
-    return {"grid": study}
+        out = {p.stem.removeprefix("study_"): p for p in sorted(EXAMPLES.glob("study_*.toml"))}
+    ring = ("mount_rings[0].x", "[0.25, 0.3]")
+    grids = {"unrestrained designs": ("symmetric", ("mount_rings[0].k_shear", "[0.0, 2.0e4]"), ring)}
+    if not out:
+        grids["grid"] = ("symmetric", ("mount_rings[0].k_axial", "[0.8e5, 1.2e5]"), ring)
+    if "asymmetric" in models:
+        grids["asymmetric"] = ("asymmetric", ("mounts[0].k_shear", "[1.5e4, 3.0e4]"), ("thrust.point[2]", "[0.0, 0.03]"))
+    for name, (model, (first, values), (second, second_values)) in grids.items():
+        path = folder / f"study_{name.replace(' ', '_')}.toml"
+        path.write_text(_GRID.format(name=name, model=str(models[model].resolve()), first=first, values=values,
+                                     second=second, second_values=second_values), encoding="utf-8")
+        out[name] = path
+    return out
+
+
+def _with_lumped_hull(folder: Path, model: Path) -> Path:
+    """``model`` on a compliant hull (a lumped foundation at every attachment)."""
+    path = folder / f"{model.stem}_lumped_hull.toml"
+    path.write_text(model.read_text(encoding="utf-8") + '\n[foundation]\nmodel = "lumped"\nmass = 30.0\n'
+                    "stiffness = 4.0e5\ndamping = 900.0\n", encoding="utf-8")
+    return path
 
 
 def cases(folder: Path) -> list[tuple[str, list[str]]]:
@@ -109,8 +135,10 @@ def cases(folder: Path) -> list[tuple[str, list[str]]]:
     if "isolation" in models:
         out.append(("response --excitation", ["response", str(models["isolation"]), "--frequencies", "1:40:16",
                                               "--excitation", "--json"]))
-    for name, path in _studies(folder, models["symmetric"]).items():
-        out.append((f"sweep {name}", ["sweep", str(path), "-o", str(folder / f"{name}.zarr"), "--no-progress"]))
+    out.append(("response lumped hull", ["response", str(_with_lumped_hull(folder, models["symmetric"])),
+                                         "--frequencies", "1:40:16", "--json"]))
+    for name, path in _studies(folder, models).items():
+        out.append((f"sweep {name}", ["sweep", str(path), "-o", str(folder / f"{path.stem}.zarr"), "--no-progress"]))
     return out
 
 
