@@ -9,14 +9,14 @@ instead (``NUMBA_CACHE_DIR``, set before numba is imported):
   (``~/.cache/impstab/...``; ``%LOCALAPPDATA%\\impstab\\...`` on Windows);
 * a ``NUMBA_CACHE_DIR`` of the user's own is left as it is (and then the caveat below is theirs).
 
-Keying. numba checks a cached function against the time stamp and size of the file that defines
-it, but not against the files it imports: a kernel that calls a compiled function or reads a
-constant of another module keeps the old machine code when only that other module changes. The
-``<key>`` above closes that gap: it is a hash of the contents of every impstab source file that
-imports numba and of every impstab module those import, directly or not (:func:`kernel_sources`).
-An edit of any of them moves the whole package to a fresh cache folder (compiled again on first
-use, or by ``python -m impstab.precompile``); edits elsewhere (commands, drawing, docs) keep it.
-``make clean-cache`` removes every cache folder.
+Keying. numba checks a cached function against the file that defines it (its time stamp, or a
+hash of its contents in recent versions), but not against the files it imports: a kernel that
+calls a compiled function or reads a constant of another module keeps the old machine code when
+only that other module changes. The ``<key>`` above closes that gap: it hashes the contents of
+every impstab module that defines numba kernels and of every impstab module those import,
+directly or not (:func:`kernel_sources`). An edit of any of them moves the whole package to a
+fresh cache folder (compiled again on first use, or by ``python -m impstab.precompile``); edits
+elsewhere (commands, drawing, docs) keep it. ``make clean-cache`` removes every cache folder.
 
 The hook costs nothing until numba is imported: :func:`install` puts a finder in front of
 ``sys.meta_path`` that computes the folder (a few milliseconds) when the first ``import numba``
@@ -31,7 +31,7 @@ import re
 import sys
 from pathlib import Path
 
-__all__ = ["install", "cache_dir", "cache_root", "kernel_sources", "source_key", "ENV"]
+__all__ = ["install", "cache_dir", "cache_root", "kernel_sources", "source_key", "is_kernel_module", "user_setting", "ENV"]
 
 #: numba's own setting (read once, when numba is imported)
 ENV = "NUMBA_CACHE_DIR"
@@ -42,6 +42,10 @@ PACKAGE = Path(__file__).resolve().parent
 
 _FROM = re.compile(rb"^[ \t]*from[ \t]+(\.+)([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^#\n]*)", re.M)
 _USES_NUMBA = re.compile(rb"^[ \t]*(?:from|import)[ \t]+numba\b", re.M)
+#: a compiled function defined here: a numba decorator, or one called on a function
+_DEFINES_KERNEL = re.compile(
+    rb"(?:^[ \t]*@[ \t]*(?:numba\.|nb\.)?|\b)(?:njit|jit|vectorize|guvectorize|cfunc|stencil|overload|intrinsic)\b[ \t]*[(\n]",
+    re.M)
 _ABSOLUTE = re.compile(rb"^[ \t]*(?:from|import)[ \t]+impstab((?:\.\w+)*)", re.M)
 
 
@@ -87,11 +91,16 @@ def _imports(path: Path, text: bytes, package: Path) -> set[Path]:
     return found
 
 
+def is_kernel_module(text: bytes) -> bool:
+    """Whether a module's source imports numba and defines compiled code."""
+    return bool(_USES_NUMBA.search(text) and _DEFINES_KERNEL.search(text))
+
+
 def kernel_sources(package: Path = PACKAGE) -> dict[Path, bytes]:
     """Contents of the source files that can reach compiled code: every module of ``package``
-    that imports numba, and every module of ``package`` they import (transitively)."""
+    that defines numba kernels, and every module of ``package`` they import (transitively)."""
     texts = {p: p.read_bytes() for p in package.rglob("*.py") if "__pycache__" not in p.parts}
-    todo = [p for p, text in texts.items() if b"numba" in text and _USES_NUMBA.search(text)]
+    todo = [p for p, text in texts.items() if b"numba" in text and is_kernel_module(text)]
     seen: set[Path] = set(todo)
     while todo:
         path = todo.pop()
@@ -111,7 +120,7 @@ def source_key(package: Path = PACKAGE) -> str:
     return h.hexdigest()
 
 
-def _users_own() -> str | None:
+def user_setting() -> str | None:
     """``NUMBA_CACHE_DIR`` if the user set it (not impstab, in this process or a parent)."""
     value = os.environ.get(ENV)
     return value if value and value != os.environ.get(SET_BY_IMPSTAB) else None
@@ -120,14 +129,14 @@ def _users_own() -> str | None:
 def cache_dir() -> Path:
     """The folder numba uses for impstab's kernels: the user's ``NUMBA_CACHE_DIR`` if set, else
     ``cache_root()/numba/<source_key()>``."""
-    own = _users_own()
+    own = user_setting()
     if own:
         return Path(own)
     return cache_root() / "numba" / source_key()
 
 
 def _configure() -> None:
-    if _users_own():
+    if user_setting():
         return
     folder = str(cache_dir())
     os.environ[ENV] = os.environ[SET_BY_IMPSTAB] = folder  # worker processes inherit both
@@ -149,7 +158,7 @@ class _BeforeNumba:
 
 def install() -> None:
     """Make numba cache impstab's kernels in :func:`cache_dir` (once per process)."""
-    if _users_own():
+    if user_setting():
         return
     if "numba" in sys.modules:
         _configure()
