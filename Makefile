@@ -8,7 +8,8 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.impstab-installed
 EXAMPLE := examples/imp_symmetric.toml
-# test processes: pytest-xdist's "auto" (one per core)
+# test processes: pytest-xdist's "auto" (one per core); a module stays on one process, so that its
+# module-scoped fixtures are computed once
 JOBS   ?= auto
 
 .PHONY: demo test compile bench clean clean-cache
@@ -27,7 +28,7 @@ demo: compile
 	@echo "locus written to demo-locus.nc and demo-locus.png"
 
 test: compile
-	MPLBACKEND=Agg $(PY) -m pytest -q -n $(JOBS)
+	MPLBACKEND=Agg $(PY) -m pytest -q -n $(JOBS) --dist loadscope
 
 bench: compile
 	$(PY) benchmarks/startup.py
