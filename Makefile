@@ -3,6 +3,8 @@
 #   make test         create/update the same .venv, compile the kernels, run the whole test suite (in parallel)
 #   make compile      compile the kernels the commands use (once; kept until their sources change)
 #   make clean-cache  remove the compiled kernels (make compile, or the first command, compiles them again)
+# pip installs without compiling every module to bytecode (half its time): Python compiles what
+# is imported, once.
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -16,7 +18,7 @@ JOBS   ?= auto
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet -e ".[test]"
+	$(PY) -m pip install --quiet --no-compile -e ".[test]"
 	touch $(STAMP)
 
 compile: $(STAMP)
