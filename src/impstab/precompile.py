@@ -1,18 +1,22 @@
 """Compile every numba kernel the command line uses, once, into impstab's cache.
 
 ``python -m impstab.precompile`` (run by ``make demo`` and ``make test`` after installing) runs
-each command on small cases in this process, so that numba compiles each kernel with the
-argument types the commands give it and stores it in the cache of :mod:`impstab._numba_cache`
-(outside the source tree; kept until the kernels' sources change). A later ``impstab critical``
-or ``impstab simulate`` loads the machine code instead of compiling it for minutes.
+each command on small cases through the command line, so that numba compiles each kernel with
+the argument types the commands give it and stores it in the cache of
+:mod:`impstab._numba_cache` (outside the source tree; kept until the kernels' sources change).
+A later ``impstab critical`` or ``impstab simulate`` loads the machine code instead of compiling
+it for minutes. The first case compiles the linear kernels every command shares; then each
+command's cases run in a process of their own (``--jobs``, default the cores available, at
+most 4), the heaviest first.
 
 The cases use the bundled ``examples/`` when run from a source tree, else two small models
 and a small study written here. A command that uses kernels gets a line in :func:`cases`;
 kernels that only the Python API reaches (or argument types only it passes) compile on their
-first call.
+first call. Whatever kernels exist are compiled this way: nothing here names them.
 
-Output: one progress line per case (name, seconds, kernels compiled / loaded from the cache),
-then a summary; exit code 1 if a case failed (its message is printed).
+Output: one progress line per case (seconds, kernel signatures compiled and loaded from the
+cache), then a summary; exit code 1 if a case failed (its message is printed). A marker in the
+cache folder makes a later run return at once.
 """
 
 from __future__ import annotations
