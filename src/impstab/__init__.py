@@ -12,23 +12,26 @@ frequency ``omega`` (rad/s); ``frequency_hz = omega / 2 pi``.
 
 from __future__ import annotations
 
-from importlib import metadata as _metadata
-
+from . import _numba_cache
 from .errors import ModelError, NumericalError
-from .linear import LinearSystem, critical_load, linearize
-from .model import DOF_NAMES, Model, load_model
 
-try:
-    __version__ = _metadata.version("impstab")
-except _metadata.PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0.0.0"
+_numba_cache.install()  # compiled kernels cached outside the source tree (see impstab._numba_cache)
 
 __all__ = [
     "__version__", "load_model", "Model", "linearize", "LinearSystem", "modes", "critical_thrust",
     "locus", "simulate", "critical_load", "modal_form", "load_study", "run_study", "open_study", "fluid", "ModelError", "NumericalError", "DOF_NAMES",
+    "frequency_response", "excitation_response",
 ]
 
+# The public names are imported on first use: ``import impstab`` (and ``impstab --version``)
+# loads neither NumPy nor the numerics.
 _LAZY = {
+    "load_model": ("model", "load_model"),
+    "Model": ("model", "Model"),
+    "DOF_NAMES": ("model", "DOF_NAMES"),
+    "linearize": ("linear", "linearize"),
+    "LinearSystem": ("linear", "LinearSystem"),
+    "critical_load": ("linear", "critical_load"),
     "modes": ("linear.modes", "modes"),
     "critical_thrust": ("linear.critical_thrust", "critical_thrust"),
     "locus": ("linear.locus", "locus"),
@@ -39,20 +42,36 @@ _LAZY = {
     "open_study": ("studies", "open_study"),
     "frequency_response": ("response", "frequency_response"),
     "excitation_response": ("response", "excitation_response"),
+    "fluid": ("fluid", None),
+    "report": ("report", None),  # a subpackage; impstab.report(path, ...) is callable
 }
-__all__ += ["frequency_response", "excitation_response", "report"]
+__all__ += ["report"]
+
+
+def _version() -> str:
+    from importlib import metadata
+
+    try:
+        return metadata.version("impstab")
+    except metadata.PackageNotFoundError:  # pragma: no cover - running from a source tree
+        return "0.0.0"
 
 
 def __getattr__(name: str):
-    if name in ("fluid", "report"):  # subpackages (impstab.report is callable: impstab.report(path, ...))
-        from importlib import import_module
-
-        return import_module(f".{name}", __name__)
-    if name in _LAZY:
+    if name == "__version__":
+        value = _version()
+    elif name in _LAZY:
         from importlib import import_module
 
         module, attr = _LAZY[name]
-        value = getattr(import_module(f".{module}", __name__), attr)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'impstab' has no attribute {name!r}")
+        value = import_module(f".{module}", __name__)
+        if attr is not None:
+            value = getattr(value, attr)
+    else:
+        raise AttributeError(f"module 'impstab' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

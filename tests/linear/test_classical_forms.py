@@ -21,6 +21,12 @@ EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "examples").glob("*.tom
 EXAMPLES = [p for p in EXAMPLES if not p.name.startswith("study_")]
 
 
+# The kernels are called with arguments of the types the library passes (read-only thrust
+# direction and point, as in a model; the start pose given, here the default unloaded one), so
+# that they reuse the machine code compiled for the commands instead of compiling variants.
+START = (0.0, np.zeros(3), np.eye(3))
+
+
 def _reference(mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency, preload):
     """``M, D, G, K0, K1`` per design from ``linearize_batch`` (classical) at thrusts 0 and big."""
     out = []
@@ -28,7 +34,7 @@ def _reference(mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tan
         big = 1e8 * max(np.abs(stiffness[i]).max(), 1e-300) * max(np.linalg.norm(positions[i], axis=-1).max(), 1e-3)
         m, d, g, k, _, _, _ = linearize_batch(
             np.array([0.0, big]), np.ones(2), mass6[i], damp6[i], positions[i], stiffness[i], damping[i], e_dir[i],
-            r_thrust[i], tangency[i], preload, 1.0, False, 1.0,
+            r_thrust[i], tangency[i], preload, 1.0, False, 1.0, *START,
         )
         out.append((m[0], d[0], g[0], k[0], (k[1] - k[0]) / big))
     return [np.array(a) for a in zip(*out)]
@@ -55,8 +61,10 @@ def _random_designs(rng, n, nm):
     damping = _spd(rng, n * nm, 1.0).reshape(n, nm, 6, 6)
     e_dir = rng.normal(size=(n, 3))
     e_dir /= np.linalg.norm(e_dir, axis=-1, keepdims=True)
+    r_thrust = rng.uniform(-0.3, 0.3, (n, 3))
+    e_dir.flags.writeable = r_thrust.flags.writeable = False  # as a model's (see START)
     return (_spd(rng, n, 10.0), _spd(rng, n, 0.1), positions, stiffness, damping, e_dir,
-            rng.uniform(-0.3, 0.3, (n, 3)), rng.uniform(0.0, 1.0, n))
+            r_thrust, rng.uniform(0.0, 1.0, n))
 
 
 @pytest.mark.parametrize("preload", [True, False])
@@ -88,7 +96,7 @@ def test_affine_form_is_the_stiffness_at_each_thrust(preload):
         thrusts = np.array([0.0, 0.01, -0.1, 1.0]) * np.abs(k0[i]).max()  # N, against arms of ~0.3 m
         mi, di, gi, ki, _, _, _ = linearize_batch(
             thrusts, np.ones(4), mass6[i], damp6[i], positions[i], stiffness[i], damping[i], e_dir[i], r_thrust[i],
-            tangency[i], preload, 1.0, False, 1.0,
+            tangency[i], preload, 1.0, False, 1.0, *START,
         )
         got = k0[i] + thrusts[:, None, None] * k1[i]
         assert np.abs(ki[-1] - ki[0]).max() > 0.05 * np.abs(ki[0]).max()  # the thrust matters

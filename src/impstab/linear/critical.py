@@ -28,7 +28,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import optimize
 
 from .eigen import cluster_participation, kinetic_shares, state_matrices
 from .families import CallableFamily, LinearFamily, SystemFamily
@@ -469,6 +468,8 @@ class _Engine:
         elif self.ops is not None and target == 0.0 and (self.undamped or k <= 2):
             root = self._root(fun, a, b, fa, fb)
         else:
+            from scipy import optimize  # imported here: a one-model `critical` rarely needs it
+
             root = optimize.brentq(fun, a, b, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=200)
         vals, vecs, m = self.decompose(root)
         sel, _ = self.select(vecs, basis, k)
@@ -545,6 +546,8 @@ class _Engine:
             if unstable[0]:
                 raise _Unstable(p)
             return float(ind[0, column])
+
+        from scipy import optimize
 
         try:
             optimize.minimize_scalar(

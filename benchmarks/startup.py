@@ -1,0 +1,191 @@
+"""Start-up: how soon impstab answers, against the interpreter importing its own base, same run.
+
+Baseline: ``python -c "import numpy, scipy.linalg, pydantic"``, what any tool of this kind pays
+before it computes anything (the goal: a warm ``critical --json`` within 2x of it).
+
+impstab, each in a fresh process (median of ``--repeat`` runs; wall time and the child's CPU time,
+user + sys, which a loaded machine disturbs less):
+
+* ``impstab --version``, ``impstab --help``;
+* ``impstab critical examples/imp_symmetric.toml --json``, warm (its kernels in the cache);
+* the first ``critical`` and the first ``simulate`` with an empty kernel cache (each its own
+  empty ``NUMBA_CACHE_DIR``: numba compiles), against the first of each after
+  ``python -m impstab.precompile`` filled another empty one (numba loads); the precompile step
+  itself is timed too (``--skip-cold`` leaves these out: minutes);
+* where a warm ``critical`` spends its time: ``python -X importtime`` self times summed by
+  top-level package, and, in one process, ``import numba`` and the load of each compiled kernel
+  from the cache.
+
+Prints tables and ratios and ends with one JSON line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "imp_symmetric.toml"
+BASELINE = [sys.executable, "-c", "import numpy, scipy.linalg, pydantic"]
+
+
+def impstab_command() -> list[str]:
+    """The ``impstab`` console script beside this interpreter, else ``python -m impstab``."""
+    script = Path(sys.executable).parent / "impstab"
+    return [str(script)] if script.is_file() else [sys.executable, "-m", "impstab"]
+
+
+def run(argv: list[str], env: dict | None = None) -> tuple[float, float, subprocess.CompletedProcess]:
+    """(wall s, CPU s of the child, the finished process)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    res = subprocess.run(argv, capture_output=True, text=True, env=env)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if res.returncode != 0:
+        raise RuntimeError(f"{' '.join(argv)} failed ({res.returncode}):\n{res.stderr}")
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, res
+
+
+def median_run(argv: list[str], repeat: int, env: dict | None = None) -> tuple[float, float]:
+    runs = [run(argv, env)[:2] for _ in range(repeat)]
+    return statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs)
+
+
+def importtime_breakdown(argv: list[str], repeat: int) -> dict[str, float]:
+    """Median over runs of ``-X importtime`` self times (s) summed by top-level package."""
+    sums: list[dict[str, float]] = []
+    for _ in range(repeat):
+        res = subprocess.run([sys.executable, "-X", "importtime", *argv], capture_output=True, text=True)
+        by: dict[str, float] = {}
+        for line in res.stderr.splitlines():
+            if not line.startswith("import time:") or "self [us]" in line:
+                continue
+            self_us, _, name = line.removeprefix("import time:").split("|", 2)
+            top = name.strip().split(".")[0]
+            by[top] = by.get(top, 0.0) + int(self_us) * 1e-6
+        sums.append(by)
+    names = set().union(*sums)
+    return {n: statistics.median(s.get(n, 0.0) for s in sums) for n in names}
+
+
+_KERNEL_LOADS = r"""
+import json, sys, time
+t0 = time.process_time()
+import numba
+t_numba = time.process_time() - t0
+from numba.core.dispatcher import Dispatcher
+loads = []
+original = Dispatcher._compile_for_args
+def timed(self, *args, **kws):
+    t = time.process_time()
+    try:
+        return original(self, *args, **kws)
+    finally:
+        loads.append((self.py_func.__module__ + "." + self.py_func.__qualname__, time.process_time() - t))
+Dispatcher._compile_for_args = timed
+from impstab.model import load_model
+from impstab.linear.critical_thrust import critical_thrust
+model = load_model(sys.argv[1])
+t = time.process_time(); critical_thrust(model); first = time.process_time() - t
+t = time.process_time(); critical_thrust(model); second = time.process_time() - t
+print(json.dumps({"import_numba": t_numba, "loads": loads, "first_call": first, "second_call": second}))
+"""
+
+
+def cold_and_precompiled(impstab: list[str], tmp: Path) -> dict[str, float]:
+    """First ``critical`` / ``simulate`` in empty caches, precompile, and both after it (wall s)."""
+    critical = [*impstab, "critical", str(EXAMPLE), "--json"]
+    simulate = [*impstab, "simulate", str(EXAMPLE), "--thrust", "19000", "--duration", "1", "--no-plot",
+                "-o", str(tmp / "sim.csv"), "--json"]
+    out = {}
+    for name, argv in (("critical", critical), ("simulate", simulate)):
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp / f"empty-{name}")}
+        wall, cpu, _ = run(argv, env)
+        out[f"cold_{name}_s"], out[f"cold_{name}_cpu_s"] = wall, cpu
+        print(f"  first {name:9s} empty cache      {wall:7.1f} s  (cpu {cpu:6.1f} s)", flush=True)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp / "precompiled")}
+    wall, cpu, _ = run([sys.executable, "-m", "impstab.precompile", "-q"], env)
+    out["precompile_s"], out["precompile_cpu_s"] = wall, cpu
+    print(f"  python -m impstab.precompile     {wall:7.1f} s  (cpu {cpu:6.1f} s)", flush=True)
+    for name, argv in (("critical", critical), ("simulate", simulate)):
+        wall, cpu, _ = run(argv, env)
+        out[f"first_{name}_s"], out[f"first_{name}_cpu_s"] = wall, cpu
+        print(f"  first {name:9s} after precompile {wall:7.1f} s  (cpu {cpu:6.1f} s)", flush=True)
+    return out
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--repeat", type=int, default=7, help="runs per warm measurement (median)")
+    parser.add_argument("--skip-cold", action="store_true", help="leave out the empty-cache runs (minutes)")
+    args = parser.parse_args()
+    impstab = impstab_command()
+    subprocess.run([sys.executable, "-m", "impstab.precompile", "-q"], check=True, capture_output=True)
+    critical = [*impstab, "critical", str(EXAMPLE), "--json"]
+    run(critical)  # warm the file system cache
+
+    print(f"warm start-up, median of {args.repeat} fresh processes (shared machine: see the cpu column too)")
+    rows = {
+        "baseline": ("python -c 'import numpy, scipy.linalg, pydantic'", BASELINE),
+        "python": ("python -c pass", [sys.executable, "-c", "pass"]),
+        "version": ("impstab --version", [*impstab, "--version"]),
+        "help": ("impstab --help", [*impstab, "--help"]),
+        "critical": ("impstab critical imp_symmetric.toml --json", critical),
+    }
+    times = {}
+    for key, (label, argv) in rows.items():
+        times[key] = median_run(argv, args.repeat)
+        print(f"  {label:46s} {times[key][0]:6.3f} s  (cpu {times[key][1]:6.3f} s)", flush=True)
+    base_wall, base_cpu = times["baseline"]
+    ratios = {k: (times[k][0] / base_wall, times[k][1] / base_cpu) for k in ("version", "help", "critical")}
+    for k, (rw, rc) in ratios.items():
+        print(f"  ratio {k:9s} / baseline: {rw:5.2f} (cpu {rc:5.2f})")
+
+    print("warm critical: import time by package (python -X importtime, self times summed, median)")
+    by = importtime_breakdown(critical[1:] if impstab[0] == sys.executable else critical,
+                              max(3, args.repeat // 2))
+    total = sum(by.values())
+    for name, sec in sorted(by.items(), key=lambda kv: -kv[1])[:12]:
+        print(f"  {name:16s} {sec * 1e3:7.1f} ms  {100 * sec / total:5.1f} %")
+    print(f"  {'total':16s} {total * 1e3:7.1f} ms")
+
+    _, _, res = run([sys.executable, "-c", _KERNEL_LOADS, str(EXAMPLE)])
+    kl = json.loads(res.stdout.strip().splitlines()[-1])
+    print(f"numba in a warm critical (cpu): import numba {kl['import_numba']:.3f} s; "
+          f"first critical_thrust {kl['first_call']:.3f} s, second {kl['second_call'] * 1e3:.2f} ms")
+    for name, sec in kl["loads"]:
+        print(f"  load from the cache  {name:50s} {sec:6.3f} s")
+
+    line = {
+        "version_s": times["version"][0], "help_s": times["help"][0], "warm_critical_s": times["critical"][0],
+        "baseline_s": base_wall, "version_ratio": ratios["version"][0], "help_ratio": ratios["help"][0],
+        "warm_critical_ratio": ratios["critical"][0], "warm_critical_cpu_ratio": ratios["critical"][1],
+        "import_numba_cpu_s": kl["import_numba"], "kernel_loads_cpu_s": kl["first_call"] - kl["second_call"],
+        "numba_import_share": by.get("numba", 0.0) / total if total else None,
+    }
+    if not args.skip_cold:
+        print("first calls: empty kernel cache against after python -m impstab.precompile")
+        with tempfile.TemporaryDirectory(prefix="impstab-startup-") as tmp:
+            cold = cold_and_precompiled(impstab, Path(tmp))
+        line.update(cold)
+        line["first_call_s"] = cold["first_critical_s"]
+        line["first_call_ratio"] = cold["cold_critical_s"] / cold["first_critical_s"]
+        line["first_simulate_ratio"] = cold["cold_simulate_s"] / cold["first_simulate_s"]
+        print(f"  ratio first critical, empty / precompiled: {line['first_call_ratio']:.1f}; "
+              f"simulate {line['first_simulate_ratio']:.1f}")
+    print(json.dumps(line))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,227 @@
+"""Start-up: the command table against the command modules, what `--help`, `--version`,
+`import impstab` and `critical --json` import, and the numba cache folder and its key."""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import pkgutil
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import impstab
+import impstab.cli as cli_pkg
+from impstab import _numba_cache
+from impstab.cli import COMMANDS, cli, main, short_help
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src"
+
+
+def _command_modules():
+    for info in pkgutil.iter_modules(cli_pkg.__path__):
+        module = importlib.import_module(f"impstab.cli.{info.name}")
+        if hasattr(module, "commands"):
+            yield info.name, module
+
+
+def test_table_lists_every_command_of_every_module():
+    defined = {c.name: name for name, module in _command_modules() for c in module.commands}
+    listed = {name: module for name, (module, _) in COMMANDS.items()}
+    missing = sorted(set(defined) - set(listed))
+    assert not missing, "add to impstab.cli.COMMANDS: " + "; ".join(
+        f'"{n}": ("{defined[n]}", "..."),' for n in missing)
+    assert listed == defined
+
+
+@pytest.mark.parametrize("name", sorted(COMMANDS))
+def test_table_help_is_the_commands_own(name):
+    command = importlib.import_module(f"impstab.cli.{COMMANDS[name][0]}")
+    command = next(c for c in command.commands if c.name == name)
+    own = command.get_short_help_str(10_000)
+    assert COMMANDS[name][1] == own, f'impstab.cli.COMMANDS entry: "{name}": ("{COMMANDS[name][0]}", "{own}"),'
+    for limit in (30, 45, 60, 200):  # the list of --help cuts both the same way at any width
+        assert short_help(COMMANDS[name][1], limit) == command.get_short_help_str(limit)
+
+
+def test_group_resolves_commands_from_the_table(capsys):
+    assert sorted(cli.commands) == sorted(COMMANDS)
+    assert "critical" in cli.commands and "no-such" not in cli.commands
+    assert cli.commands["critical"].name == "critical"
+    assert main(["no-such-command"]) == 2
+    assert "No such command" in capsys.readouterr().err
+
+
+def test_help_lists_every_command_with_its_help(capsys):
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
+    for name, (_, text) in COMMANDS.items():
+        line = next(l for l in out.splitlines() if l.strip().startswith(name + " "))
+        shown = line.strip()[len(name):].strip()
+        assert text.startswith(shown.removesuffix("...")), (name, shown)
+
+
+def _imported(*code_or_argv: str, env_extra: dict | None = None) -> set[str]:
+    """Top-level modules loaded by a fresh interpreter running impstab's command line (or code)."""
+    probe = (
+        "import sys, json\n"
+        "from impstab.cli import main\n"
+        "try:\n    code = main(sys.argv[1:])\n"
+        "finally:\n    sys.stderr.write('\\nMODULES ' + json.dumps(sorted(sys.modules)) + '\\n')\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(SRC), **(env_extra or {})}
+    res = subprocess.run([sys.executable, "-c", probe, *code_or_argv], capture_output=True, text=True, env=env,
+                         timeout=600)
+    assert res.returncode == 0, res.stderr
+    line = [l for l in res.stderr.splitlines() if l.startswith("MODULES ")][-1]
+    return set(json.loads(line.removeprefix("MODULES ")))
+
+
+NUMERICS = ("numpy", "scipy", "numba", "pydantic", "rich", "matplotlib", "xarray", "dask", "zarr")
+
+
+@pytest.mark.parametrize("argv", [["--version"], ["--help"]])
+def test_help_and_version_import_no_numerics(argv):
+    loaded = _imported(*argv)
+    assert not [m for m in NUMERICS if m in loaded]
+    assert not [m for m in loaded if m.startswith(("impstab.model", "impstab.linear", "impstab.dynamics", "impstab.cli."))
+                and m != "impstab.cli._common"]
+
+
+def test_a_commands_help_imports_its_module_only():
+    loaded = _imported("critical", "--help")
+    assert "impstab.cli.core" in loaded
+    assert not [m for m in loaded if m.startswith(("impstab.cli.sweep", "impstab.cli.simulate", "impstab.cli.response"))]
+    assert not [m for m in NUMERICS[1:] if m in loaded]  # NumPy only (the module imports it)
+
+
+def test_import_impstab_is_cheap_and_names_stay_public():
+    res = subprocess.run(
+        [sys.executable, "-c", "import sys, impstab; print(sorted(m for m in sys.modules if m.split('.')[0] in "
+         f"{NUMERICS!r} or m.startswith('impstab.')))"],
+        capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(SRC)}, timeout=120,
+    )
+    assert res.returncode == 0, res.stderr
+    assert eval(res.stdout) == ["impstab._numba_cache", "impstab.errors"]
+    for name in impstab.__all__:
+        assert getattr(impstab, name) is not None, name
+    assert set(impstab.__all__) <= set(dir(impstab))
+    from impstab.linear import LinearSystem, critical_load, linearize
+
+    assert (impstab.linearize, impstab.critical_load, impstab.LinearSystem) == (linearize, critical_load, LinearSystem)
+    with pytest.raises(AttributeError, match="no_such_name"):
+        impstab.no_such_name  # noqa: B018
+
+
+def test_critical_json_imports_no_plotting_tables_or_stores(examples):
+    loaded = _imported("critical", str(examples / "imp_symmetric.toml"), "--json")
+    heavy = [m for m in ("matplotlib", "xarray", "dask", "zarr", "rich", "scipy.optimize", "h5py", "pandas")
+             if m in loaded]
+    assert heavy == []
+
+
+# -- the numba cache ------------------------------------------------------------------------------
+def _package_copy(tmp_path: Path) -> Path:
+    dest = tmp_path / "impstab"
+    shutil.copytree(Path(impstab.__file__).parent, dest, ignore=shutil.ignore_patterns("__pycache__"))
+    return dest
+
+
+def test_key_follows_kernel_sources_and_their_imports(tmp_path):
+    pkg = _package_copy(tmp_path)
+    sources = _numba_cache.kernel_sources(pkg)
+    names = {p.relative_to(pkg).as_posix() for p in sources}
+    users = {p.relative_to(pkg).as_posix() for p in pkg.rglob("*.py")
+             if _numba_cache.is_kernel_module(p.read_bytes())}
+    assert users and users <= names  # every module that defines kernels
+    assert "precompile.py" not in names  # imports numba to find the kernels, defines none
+    key = _numba_cache.source_key(pkg)
+    assert _numba_cache.source_key(pkg) == key  # deterministic
+    # a module no kernel reaches (a command): editing it keeps the compiled code
+    (pkg / "cli" / "schema.py").write_text((pkg / "cli" / "schema.py").read_text() + "\n# edit\n")
+    assert "cli/schema.py" not in names and _numba_cache.source_key(pkg) == key
+    # a kernel's own file
+    kernel = pkg / sorted(users)[0]
+    kernel.write_text(kernel.read_text() + "\n# edit\n")
+    key2 = _numba_cache.source_key(pkg)
+    assert key2 != key
+    # a plain module whose constant a kernel module imports (numba freezes it into the code),
+    # reached through a package __init__ that re-exports it
+    (pkg / "constants_only.py").write_text("LIMIT = 1.0\n")
+    (pkg / "reexport").mkdir()
+    (pkg / "reexport" / "__init__.py").write_text("from ..constants_only import LIMIT\n")
+    (pkg / "kernel_user.py").write_text("from numba import njit\nfrom .reexport import (\n    LIMIT,\n)\n\n\n"
+                                        "@njit(cache=True)\ndef scaled(x):\n    return LIMIT * x\n")
+    key3 = _numba_cache.source_key(pkg)
+    assert {"constants_only.py", "reexport/__init__.py", "kernel_user.py"} <= {
+        p.relative_to(pkg).as_posix() for p in _numba_cache.kernel_sources(pkg)}
+    (pkg / "constants_only.py").write_text("LIMIT = 2.0\n")
+    assert _numba_cache.source_key(pkg) not in (key, key2, key3)
+
+
+def test_numba_cache_folder_is_outside_the_sources_and_the_users_setting_wins(tmp_path):
+    code = ("import os, impstab, numba.core.config as c; "
+            "print(os.environ.get('NUMBA_CACHE_DIR')); print(c.CACHE_DIR)")
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", _numba_cache.SET_BY_IMPSTAB)}
+    env["PYTHONPATH"] = str(SRC)
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+    assert res.returncode == 0, res.stderr
+    env_dir, config_dir = res.stdout.split()
+    assert env_dir == config_dir == str(_numba_cache.cache_root() / "numba" / _numba_cache.source_key())
+    assert not Path(env_dir).is_relative_to(SRC)
+    own = tmp_path / "own"
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env={**env, "NUMBA_CACHE_DIR": str(own)}, timeout=300)
+    assert res.stdout.split() == [str(own), str(own)]
+    # inherited from an impstab process (a worker): computed again, not taken as the user's own
+    stale = str(tmp_path / "parent")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env={**env, "NUMBA_CACHE_DIR": stale, _numba_cache.SET_BY_IMPSTAB: stale}, timeout=300)
+    assert res.stdout.split() == [env_dir, env_dir]
+    # numba imported before impstab: the folder still applies to impstab's kernels
+    res = subprocess.run([sys.executable, "-c", "import numba; " + code], capture_output=True, text=True, env=env,
+                         timeout=300)
+    assert res.stdout.split() == [env_dir, env_dir]
+
+
+# -- the precompile step ---------------------------------------------------------------------------
+@pytest.mark.parametrize("from_examples", [True, False])
+def test_precompile_cases_are_valid_command_lines(tmp_path, monkeypatch, from_examples):
+    from impstab import precompile
+    from impstab.model import load_model
+
+    if not from_examples:  # an installed package: no examples beside it, models written instead
+        monkeypatch.setattr(precompile, "EXAMPLES", tmp_path / "missing")
+    todo = precompile.cases(tmp_path)
+    commands = {argv[0] for _, argv in todo}
+    assert {"critical", "simulate", "response", "sweep", "locus"} <= commands <= set(COMMANDS)
+    for label, argv in todo:
+        command = cli.commands[argv[0]]
+        command.make_context(argv[0], list(argv[1:]))  # options and arguments parse
+        model = Path(argv[1])
+        assert model.is_file(), label
+        if model.name.startswith("imp_"):
+            load_model(model)
+        elif argv[0] == "sweep":
+            impstab.load_study(model)
+    if not from_examples:
+        assert all(Path(argv[1]).is_relative_to(tmp_path) for _, argv in todo)
+
+
+def test_precompile_stops_at_a_complete_cache_and_keeps_the_users_own(tmp_path, monkeypatch, capsys):
+    from impstab import precompile
+
+    own = tmp_path / "own"
+    own.mkdir()
+    (own / precompile.MARKER).write_text("done\n")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(own))
+    monkeypatch.delenv(_numba_cache.SET_BY_IMPSTAB, raising=False)
+    assert precompile.main(["--quiet"]) == 0
+    assert "already compiled" in capsys.readouterr().out
+    assert precompile.main(["--clean"]) == 0
+    assert "not removed" in capsys.readouterr().out and (own / precompile.MARKER).is_file()
