@@ -78,10 +78,15 @@ class Model:
         return mount_damping(self.mounts)
 
     @property
+    def is_nonlinear(self) -> bool:
+        """True when a mount carries a nonlinear law (cubic springs or a snubber)."""
+        return any(m.is_nonlinear for m in self.mounts)
+
+    @property
     def is_damped(self) -> bool:
         return any(np.any(m.damping != 0) for m in self.mounts)
 
     def undamped(self) -> "Model":
         """The same model with every mount damper removed."""
-        mounts = tuple(Mount(m.position, m.stiffness, np.zeros((6, 6))) for m in self.mounts)
+        mounts = tuple(replace(m, damping=np.zeros((6, 6))) for m in self.mounts)
         return replace(self, mounts=mounts)

@@ -56,6 +56,11 @@ class MountSpec(_Strict):
     c_shear: NonNegative = 0.0
     stiffness: Optional[Mat6] = None
     damping: Optional[Mat6] = None
+    # nonlinear mount law (axial-shear mounts only; see impstab.model.mount_law)
+    k3_axial: Finite = 0.0
+    k3_shear: Finite = 0.0
+    snubber_clearance: NonNegative = 0.0
+    snubber_stiffness: NonNegative = 0.0
 
 
 class MountRingSpec(_Strict):
@@ -68,6 +73,11 @@ class MountRingSpec(_Strict):
     k_shear: NonNegative
     c_axial: NonNegative = 0.0
     c_shear: NonNegative = 0.0
+    # nonlinear mount law (see impstab.model.mount_law)
+    k3_axial: Finite = 0.0
+    k3_shear: Finite = 0.0
+    snubber_clearance: NonNegative = 0.0
+    snubber_stiffness: NonNegative = 0.0
 
 
 class ThrustSpec(_Strict):
