@@ -19,7 +19,7 @@ from impstab.model import model_from_dict
 
 
 def forces(pk, thrust, u, rot):
-    return pose_forces(u, rot, thrust, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency)[0]
+    return pose_forces(u, rot, thrust, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency, pk.laws)[0]
 
 
 def fd_jacobian(pk, thrust, u0, r0, h=1e-6):
@@ -62,7 +62,7 @@ def test_preload_switch_drops_only_mount_preload_term():
     on_lin, off_lin = linearize(model, t), linearize(off, t)
     pk = pack_model(model)
     _, _, k_pre, _, _ = pose_forces(on_lin.displacement, on_lin.rotation, t, pk.positions, pk.stiffness,
-                                    pk.damping, pk.e_dir, pk.r_thrust, pk.tangency)
+                                    pk.damping, pk.e_dir, pk.r_thrust, pk.tangency, pk.laws)
     assert np.allclose(on_lin.K - off_lin.K, k_pre, rtol=1e-12, atol=1e-9)
     assert np.abs(k_pre[:3]).max() == 0 and np.abs(k_pre[:, :3]).max() == 0
 
