@@ -28,10 +28,14 @@ from numba import njit
 from ..kinematics.so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _skew
 from ..model.mount_law import LAW_K3_AXIAL, N_LAW, law_gradient, law_hessian
 
-__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_forms", "MAX_PREDICTOR"]
+__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_forms", "MAX_PREDICTOR",
+           "NEWTON_FLOOR"]
 
 #: largest accepted predictor step of the continuation (rad, or fraction of the length scale)
 MAX_PREDICTOR = 0.02
+#: Newton corrections below this (relative to the length scale, or rad) that stop shrinking are
+#: rounding: the equilibrium is converged
+NEWTON_FLOOR = 1e-9
 
 
 @njit(cache=True)
@@ -122,6 +126,13 @@ def static_equilibrium_packed(
     thereby refused: where no nearby equilibrium exists (a limit point) the result is not
     converged. Returns ``(u, rot, iterations, converged)``.
 
+    Convergence: a correction below ``1e-13`` (relative to the length scale, or rad) twice, or
+    one below ``NEWTON_FLOOR`` that is no smaller than the one before it. The second rule
+    recognises the rounding floor of the equilibrium: where the mounts are very soft against
+    the thrust (a shear stiffness of 1 N/m under 8 kN) rounding of the forces alone moves the
+    pose by more than ``1e-13``, and Newton's corrections stop shrinking there instead of
+    falling below a fixed tolerance. Converging Newton corrections always shrink (quadratically,
+    or by a factor 1/2 at a limit point), so a correction that does not shrink is rounding.
     """
     total = 0
     u = u0.copy()
@@ -136,6 +147,7 @@ def static_equilibrium_packed(
             small = 0
             first = -1.0
             later = 0.0
+            previous = np.inf
             for it in range(60):
                 qf, kel, kpre, kthr, _ = pose_forces(
                     u, rot, load, positions, stiffness, damping, e_dir, r_thrust, tangency, laws
@@ -151,6 +163,10 @@ def static_equilibrium_packed(
                     later += size
                 if first > MAX_PREDICTOR or later > 0.5 * first + 1e-10:
                     break
+                if size < NEWTON_FLOOR and size >= previous:
+                    converged = True  # the rounding floor: keep the pose before this correction
+                    break
+                previous = size
                 u = u + step[:3]
                 rot = _exp_so3(step[3:]) @ rot
                 if size < 1e-13:
