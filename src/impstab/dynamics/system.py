@@ -7,8 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .rhs import (KIND_LINEAR, KIND_MODEL, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH, P_RT, P_TANG,
-                  PITCH_LIMIT, mount_loads_series, rhs_into)
+from ..model.mount_law import N_LAW
+from .rhs import (FLAG_LAW, FLAG_ROTATION, KIND_LINEAR, KIND_MODEL, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH,
+                  P_RADIATION, P_ROTATION, P_RT, P_TANG, PITCH_LIMIT, mount_loads_series, rhs_into)
 
 __all__ = ["DynamicSystem", "pack_dynamics", "linear_dynamics", "evaluate_rhs", "mount_loads"]
 
@@ -35,8 +36,10 @@ def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
 
     pk = pack_model(model)
     nm = pk.positions.shape[0]
-    full = np.array([int(np.any(k[3:, :] != 0) or np.any(k[:, 3:] != 0) or np.any(c[3:, :] != 0)
-                         or np.any(c[:, 3:] != 0)) for k, c in zip(pk.stiffness, pk.damping)], dtype=np.int64)
+    rotational = [bool(np.any(k[3:, :] != 0) or np.any(k[:, 3:] != 0) or np.any(c[3:, :] != 0) or np.any(c[:, 3:] != 0))
+                  for k, c in zip(pk.stiffness, pk.damping)]
+    nonlinear = np.any(pk.laws[:, 3:] != 0.0, axis=1)
+    flags = np.array([FLAG_ROTATION * r + FLAG_LAW * int(nl) for r, nl in zip(rotational, nonlinear)], dtype=np.int64)
     par = np.zeros(N_PAR)
     body = model.body
     par[P_MASS] = body.mass
@@ -47,10 +50,12 @@ def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
     par[P_TANG] = pk.tangency
     par[P_JP] = pk.polar_inertia
     par[P_PITCH] = float(pitch_limit)
+    par[P_ROTATION] = float(any(rotational))
+    par[P_RADIATION] = float(np.any(pk.damp6 != 0.0))
     arrays = (
         np.ascontiguousarray(pk.positions), np.ascontiguousarray(pk.stiffness),
-        np.ascontiguousarray(pk.damping), full, par, np.ascontiguousarray(np.linalg.inv(pk.mass6)),
-        np.ascontiguousarray(pk.damp6), np.zeros((1, 1)),
+        np.ascontiguousarray(pk.damping), flags, np.ascontiguousarray(pk.laws), par,
+        np.ascontiguousarray(np.linalg.inv(pk.mass6)), np.ascontiguousarray(pk.damp6), np.zeros((1, 1)),
     )
     return DynamicSystem(KIND_MODEL, arrays, 12, nm, float(pk.length_scale))
 
@@ -60,7 +65,7 @@ def linear_dynamics(amat) -> DynamicSystem:
     amat = np.ascontiguousarray(amat, dtype=float)
     n = amat.shape[0]
     arrays = (np.zeros((0, 3)), np.zeros((0, 6, 6)), np.zeros((0, 6, 6)), np.zeros(0, dtype=np.int64),
-              np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat)
+              np.zeros((0, N_LAW)), np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat)
     return DynamicSystem(KIND_LINEAR, arrays, n, 0)
 
 
