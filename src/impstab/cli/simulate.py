@@ -180,6 +180,13 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
 
     con = Console(highlight=False, width=None if sys.stdout.isatty() else 160)
     con.print(_table(results, model.name))
+    for r in results:
+        g = r.growth
+        if g is not None and g.envelope == "limit cycle" and g.amplitude:
+            amps = ", ".join(f"{k} {v:.4g} {'m' if k in ('surge', 'sway', 'heave') else 'rad'}" for k, v in g.amplitude.items())
+            con.print(f"T = {r.thrust[0]:.6g} N: limit cycle, period {g.period:.6g} s, amplitude {amps}", markup=False)
+        if g is not None and g.reason:
+            con.print(f"T = {r.thrust[0]:.6g} N: {g.envelope}: {g.reason}", markup=False)
     con.print(f"critical thrust {crit:.8g} N" if crit is not None else "no critical thrust up to thrust_max")
     con.print(f"wrote {out} and {png}")
 

@@ -16,9 +16,13 @@ def _label(result) -> str:
 
 def _growth_note(result) -> str:
     g = result.growth
-    if g is None or not np.isfinite(g.rate):
+    if g is None:
         return ""
-    note = f"envelope: {g.envelope}\nfitted growth {g.rate:.4g} 1/s"
+    note = f"envelope: {g.envelope}"
+    if g.envelope == "limit cycle" and g.amplitude:
+        note += f"\nperiod {g.period:.4g} s, {g.dof} ±{g.amplitude[g.dof]:.3g}"
+    if np.isfinite(g.rate):
+        note += f"\nfitted growth {g.rate:.4g} 1/s"
     if g.linear_rate is not None:
         note += f"\nmax Re(λ) {g.linear_rate:.4g} 1/s"
     return note
