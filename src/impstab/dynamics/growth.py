@@ -76,7 +76,9 @@ MISFIT_TOL = 1e-2
 CYCLE_RTOL = 1e-3
 #: samples per period of the fastest mode used by the modal fit, and its largest sample count
 FIT_SAMPLES_PER_PERIOD = 8
-FIT_MAX_SAMPLES = 4000
+FIT_MAX_SAMPLES = 3000
+#: columns (state snapshots) of the block Hankel matrix of the modal fit
+HANKEL_COLUMNS = 600
 #: motion below this fraction of the length scale is rounding, not motion
 NO_MOTION = 1e-10
 #: thrusts within this relative distance of the critical thrust are classified "critical"
@@ -185,10 +187,15 @@ def modal_fit(y: Array, dt: float, sv_tol: float = 1e-7) -> ModalFit | None:
     cols = n_samples - rows
     if cols < 2 * rows or not np.any(y):
         return None
-    hankel = np.empty((rows * p, cols))
+    # the columns are state snapshots: a spread of HANKEL_COLUMNS of them over the window spans
+    # the same column space as all of them
+    snap = np.arange(0, cols, max(1, cols // HANKEL_COLUMNS))
+    hankel = np.empty((rows * p, snap.size))
     for i in range(rows):
-        hankel[i * p:(i + 1) * p] = y[i:i + cols].T
-    u, s, _ = np.linalg.svd(hankel, full_matrices=False)
+        hankel[i * p:(i + 1) * p] = y[i + snap].T
+    # left singular vectors and values of the wide Hankel matrix from its R factor (H^T = Q R,
+    # so H = R^T Q^T): the same numbers, at a fraction of the cost of a direct SVD
+    u, s, _ = np.linalg.svd(np.linalg.qr(hankel.T, mode="r").T)
     order = int(min(np.sum(s > sv_tol * s[0]), (rows - 1) * p))
     obs = u[:, :order] * np.sqrt(s[:order])
     amat = np.linalg.lstsq(obs[:-p], obs[p:], rcond=None)[0]
@@ -243,6 +250,19 @@ def _extremum(x: Array, sign: float) -> float:
     return float(x[i])
 
 
+def _refined_extrema(t: Array, x: Array, sign: float) -> tuple[Array, Array]:
+    """Times and values of the local maxima (``sign = 1``) or minima (``-1``) of the samples
+    ``x``, each refined by the parabola through it and its neighbours."""
+    y = sign * x
+    i = np.nonzero((y[1:-1] >= y[:-2]) & (y[1:-1] > y[2:]))[0] + 1
+    ym, y0, yp = y[i - 1], y[i], y[i + 1]
+    curv = yp - 2.0 * y0 + ym
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shift = np.clip(np.where(curv < 0, 0.5 * (ym - yp) / curv, 0.0), -1.0, 1.0)
+        peak = np.where(curv < 0, y0 - 0.125 * (yp - ym) ** 2 / curv, y0)
+    return t[i] + shift * (t[i + 1] - t[i]), sign * peak
+
+
 def _upward_crossings(t: Array, x: Array) -> Array:
     """Times where ``x`` crosses zero upwards (linear interpolation)."""
     i = np.nonzero((x[:-1] < 0.0) & (x[1:] >= 0.0))[0]
@@ -269,11 +289,15 @@ def _tail_cycle(t: Array, disp: Array, j: int) -> _Cycle | None:
     if cross.size < 6:
         return None
     periods = np.diff(cross)
-    amps = []
-    for a, b in zip(cross[:-1], cross[1:]):
-        sel = (tt >= a) & (tt <= b)
-        amps.append(0.5 * (_extremum(x[sel], 1.0) - _extremum(x[sel], -1.0)) if sel.sum() >= 3 else math.nan)
-    amps = np.asarray(amps)
+    # half peak-to-peak of each period: the largest refined maximum and the smallest refined
+    # minimum between its two crossings
+    tmax, vmax = _refined_extrema(tt, x, 1.0)
+    tmin, vmin = _refined_extrema(tt, x, -1.0)
+    if tmax.size < cross.size - 1 or tmin.size < cross.size - 1:
+        return None
+    hi = np.maximum.reduceat(vmax, np.minimum(np.searchsorted(tmax, cross[:-1]), tmax.size - 1))
+    lo = np.minimum.reduceat(vmin, np.minimum(np.searchsorted(tmin, cross[:-1]), tmin.size - 1))
+    amps = 0.5 * (hi - lo)
     last_p, last_a = periods[-1], amps[-1]
     # compared over the last half of these periods (at least three): an approach that slows
     # geometrically is judged by how far it still went over many periods, not over the last one
@@ -432,9 +456,9 @@ def _fit(y: Array, i0: int, i1: int, sample: float, omega_max: float | None) -> 
 
 
 def _growth_phase_fit(y, env, sample, omega_max) -> ModalFit | None:
-    """Modal fit where the envelope is below a tenth of its final value (the small-amplitude
-    growth towards a limit cycle)."""
-    small = np.nonzero(env >= env[-1] / 10.0)[0]
+    """Modal fit where the envelope is below a hundredth of its final value (the small-amplitude
+    growth towards a limit cycle, where the nonlinear terms are 1e-4 of the motion)."""
+    small = np.nonzero(env >= env[-1] / 100.0)[0]
     end = int(small[0]) if small.size else len(y) - 1
     if end < 24:
         return None
