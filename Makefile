@@ -28,6 +28,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/fluid.py
 	$(PY) benchmarks/simulate.py
 	$(PY) benchmarks/sweep.py
+	$(PY) benchmarks/response.py
 
 clean:
 	rm -rf $(VENV) demo-locus.nc demo-locus.png

@@ -37,7 +37,10 @@ _LAZY = {
     "load_study": ("studies", "load_study"),
     "run_study": ("studies", "run_study"),
     "open_study": ("studies", "open_study"),
+    "frequency_response": ("response", "frequency_response"),
+    "excitation_response": ("response", "excitation_response"),
 }
+__all__ += ["frequency_response", "excitation_response"]
 
 
 def __getattr__(name: str):

@@ -65,12 +65,13 @@ def test_plot_returns_axes(run):
     from impstab.plot.simulation import plot_simulations
 
     ax_s, ax_p = run.plot()
-    assert ax_s.get_ylabel() == "sway (m)" and "pitch" in ax_p.get_ylabel()
-    np.testing.assert_array_equal(ax_s.lines[0].get_ydata(), run.displacement[:, 1])
+    assert ax_s.get_ylabel() == "sway (µm)" and ax_p.get_ylabel() == "pitch (µrad)"  # 1e-5 kick
+    n = ax_s.lines[0].get_ydata().size
+    np.testing.assert_allclose(ax_s.lines[0].get_ydata() * 1e-6, run.displacement[:n, 1], rtol=1e-15)
     _, one = plt.subplots()
     assert run.plot(ax=one) is one
     axes = plot_simulations([run, run, run])
-    assert axes.shape == (2, 3)
+    assert len(axes.sway) == 3 and len(axes.pitch) == 3
     plt.close("all")
 
 
@@ -96,7 +97,7 @@ def test_slow_ramp_ends_at_the_static_equilibrium():
 
 def test_default_perturbation_and_validation(ring):
     p = Perturbation.coerce(None)
-    assert dict(zip(DOF_NAMES, p.velocity)) == {"surge": 0, "sway": 1e-5, "heave": 0, "roll": 0, "pitch": 0, "yaw": 1e-5}
+    assert dict(zip(DOF_NAMES, p.velocity)) == {"surge": 0, "sway": 1e-5, "heave": 0, "roll": 0, "pitch": 1e-5, "yaw": 0}
     assert not any(p.displacement)
     for bad in ({"velocity": {"swya": 1.0}}, {"displacment": {}}, [1.0, 2.0], {"velocity": [np.nan] * 6}):
         with pytest.raises(impstab.ModelError):

@@ -64,9 +64,9 @@ def test_plot_draws_on_given_axes(map_store):
     fig, ax = plt.subplots()
     assert res.plot(ax=ax) is ax
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert "stable up to thrust_max" in labels and "flutter (no hatching)" in labels
-    assert "operating thrust (margin 1)" in labels  # this range crosses the operating thrust
-    assert "k_shear" in ax.get_ylabel() and "(N/m)" in ax.get_ylabel()
+    assert any(t.startswith("stable up to thrust_max = 20000 N") for t in labels)
+    assert any(t.startswith("margin < 1") for t in labels)  # this range crosses the operating thrust
+    assert ax.get_ylabel() == "mount shear stiffness k_shear (N/m)"
     plt.close(fig)
 
 
@@ -102,7 +102,7 @@ def test_three_parameters_one_parameter_and_samples(tmp_path):
                         name="three.toml")
     res = run_study(load_study(three), None)
     ax = res.plot(x="mount_rings[0].k_shear", y="mount_rings[0].x", at={"mount_rings[0].count": 4})
-    assert "mount_rings[0].count = 4" in ax.get_title() and ax.get_xscale() == "log"
+    assert "mounts per ring = 4" in ax.get_title() and ax.get_xscale() == "log"
     plt.close(ax.figure)
     one = write_study(tmp_path, '[[parameters]]\npath = "mount_rings[0].x"\nvalues = { start = 0.1, stop = 0.4, num = 7 }',
                       name="one.toml")

@@ -10,7 +10,8 @@ import sys
 
 import click
 
-from . import added_mass, core, simulate, sweep
+from . import added_mass, core, schema, simulate, stats, sweep
+from . import response as response_cli
 from ._common import run_guarded
 
 __all__ = ["main", "cli"]
@@ -22,7 +23,7 @@ def cli() -> None:
     """impstab: dynamic stability of soft-mounted propulsors under follower thrust."""
 
 
-for _module in (core, added_mass, simulate, sweep):
+for _module in (core, added_mass, simulate, sweep, schema, response_cli, stats):
     for _command in _module.commands:
         cli.add_command(_command)
 

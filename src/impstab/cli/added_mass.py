@@ -8,7 +8,7 @@ import click
 import numpy as np
 
 from ..errors import ModelError
-from ._common import console, print_json
+from ._common import check_number, console, fmt, print_json, table
 
 __all__ = ["commands", "parse_frequencies"]
 
@@ -33,8 +33,8 @@ def parse_frequencies(spec: str) -> np.ndarray:
     return np.linspace(start, stop, num)
 
 
-def _fmt(x: float | None, digits: int = 6) -> str:
-    return "-" if x is None else f"{x:.{digits}g}"
+def _fmt(x: float | None, digits: int = 6, missing: str = "none (incompressible)") -> str:
+    return fmt(x, digits=digits, missing=missing)
 
 
 def _with_flag_names(call, *args, **kwargs) -> Any:
@@ -48,11 +48,7 @@ def _with_flag_names(call, *args, **kwargs) -> Any:
 
 
 def _point_table(r) -> None:
-    from rich.table import Table
-
-    table = Table(title=f"baffled cylinder  a = {r.radius:g} m, L = {r.length:g} m")
-    for name, justify in (("quantity", "left"), ("value", "right"), ("unit", "left")):
-        table.add_column(name, justify=justify)
+    out = table(f"baffled cylinder  a = {r.radius:g} m, L = {r.length:g} m", "quantity", ("value", "right"), "unit")
     rows = (
         ("added mass m_a", r.added_mass, "kg"),
         ("added inertia I_a (about the centre)", r.added_inertia, "kg m^2"),
@@ -67,24 +63,23 @@ def _point_table(r) -> None:
         ("error estimate (relative)", r.error_estimate, ""),
     )
     for label, value, unit in rows:
-        table.add_row(label, "incompressible" if value is None and "sound" in label else _fmt(value), unit)
-    console().print(table)
+        out.add_row(label, "incompressible" if value is None and "sound" in label else _fmt(value), unit)
+    console().print(out)
 
 
 def _sweep_table(sweep) -> None:
-    from rich.table import Table
-
     first = sweep.points[0]
-    table = Table(title=f"baffled cylinder  a = {first.radius:g} m, L = {first.length:g} m, "
-                        f"c = {_fmt(first.sound_speed)} m/s")
-    for name in ("f (Hz)", "m_a (kg)", "m_a/strip", "I_a (kg m^2)", "I_a/strip", "R (N s/m)",
-                 "R_rot (N m s)", "loss factor"):
-        table.add_column(name, justify="right")
+    c = "incompressible" if first.sound_speed is None else f"c = {_fmt(first.sound_speed)} m/s"
+    out = table(f"baffled cylinder  a = {first.radius:g} m, L = {first.length:g} m, {c}",
+                *((name, "right") for name in ("f (Hz)", "m_a (kg)", "m_a/strip", "I_a (kg m^2)", "I_a/strip",
+                                                "R (N s/m)", "R_rot (N m s)", "loss factor (1)")))
     for p in sweep.points:
-        table.add_row(*(_fmt(v) for v in (
+        out.add_row(*(_fmt(v, missing="n/a") for v in (
             p.frequency, p.added_mass, p.strip_ratio, p.added_inertia, p.inertia_strip_ratio,
             p.radiation_resistance, p.rotational_radiation_resistance, p.loss_factor)))
-    console().print(table)
+    console().print(out)
+    if first.sound_speed is None:
+        console().print("R, R_rot, loss factor: n/a, there is no radiation in an incompressible fluid (give --sound-speed)")
 
 
 def _progress(values):
@@ -105,9 +100,12 @@ def _progress(values):
               help="Sweep NUM equally spaced frequencies from START to STOP (Hz, inclusive).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object on stdout and nothing else.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
-              help="With --frequencies: plot the coefficients against frequency to this PNG file.")
+              help="With --frequencies: plot the coefficients against frequency to this figure "
+                   "(.png, .svg or .pdf), or write them to a netCDF file (.nc).")
+@click.option("--dpi", type=float, default=None, help="Resolution of a PNG figure (default 150).")
 def added_mass_cmd(radius: float, length: float, density: float, sound_speed: float | None,
-                   frequency: float, frequencies: str | None, as_json: bool, output: str | None) -> None:
+                   frequency: float, frequencies: str | None, as_json: bool, output: str | None,
+                   dpi: float | None) -> None:
     """Added mass, added inertia and radiation resistance of a cylinder segment in a baffle.
 
     Coefficients are for transverse motion about the segment centre (SI units, frequency in Hz).
@@ -125,27 +123,33 @@ def added_mass_cmd(radius: float, length: float, density: float, sound_speed: fl
         return
     if frequency != 0.0:
         raise ModelError("--frequencies", frequencies, "give either --frequency or --frequencies, not both")
-    if output is not None and not output.lower().endswith(".png"):
-        raise ModelError("--output", output, "must be a .png file")
+    if output is not None and not output.lower().endswith(".nc"):
+        from ..plot.save import check_figure_path
+
+        check_figure_path(output)
+    check_number("--dpi", dpi, positive=True)
     grid = parse_frequencies(frequencies)
     # validate the geometry before a long sweep starts
     _with_flag_names(fluid.baffled_cylinder, radius, length, density, sound_speed, 0.0)
     sweep = _with_flag_names(fluid.frequency_sweep, radius, length, grid, density, sound_speed,
                              progress=_progress)
-    if output is not None:
-        _save_png(sweep, output)
+    if output is not None and output.lower().endswith(".nc"):
+        from ..io import atomic_path
+
+        with atomic_path(output) as tmp:
+            sweep.to_xarray().to_netcdf(tmp, engine="h5netcdf")
+    elif output is not None:
+        _save_figure(sweep, output, dpi)
     if as_json:
         print_json(sweep.to_dict())
     else:
         _sweep_table(sweep)
 
 
-def _save_png(sweep, output: str) -> None:
-    from ..io import atomic_path
+def _save_figure(sweep, output: str, dpi: float | None) -> None:
+    from ..plot.save import save_figure
 
-    fig = sweep.plot()
-    with atomic_path(output) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+    save_figure(sweep.plot(), output, dpi)
 
 
 commands = [added_mass_cmd]

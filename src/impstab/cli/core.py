@@ -8,7 +8,7 @@ import click
 import numpy as np
 
 from ..errors import ModelError
-from ._common import check_number, console, print_json
+from ._common import check_number, console, data_and_figure, draw_and_save, figure_options, fmt, print_json, table
 
 __all__ = ["commands"]
 
@@ -21,18 +21,18 @@ def _load(path: str):
     return load_model(path)
 
 
-def _fmt(x: float | None, unit: str = "", digits: int = 6) -> str:
-    if x is None:
-        return "-"
-    return f"{x:.{digits}g}{(' ' + unit) if unit else ''}"
+def _fmt(x: float | None, unit: str = "", digits: int = 6, missing: str = "n/a") -> str:
+    return fmt(x, unit, digits, missing)
+
+
+def _vec(v, unit: str) -> str:
+    return "[" + ", ".join(fmt(float(x), digits=6) for x in np.asarray(v, dtype=float)) + f"] {unit}"
 
 
 @click.command("check")
 @click.argument("model_file", type=click.Path(dir_okay=False))
 def check_cmd(model_file: str) -> None:
     """Validate MODEL_FILE and print a summary of the assembled model."""
-    from rich.table import Table
-
     from ..linear.modes import modes
     from ..model.model import DOF_NAMES
 
@@ -40,40 +40,86 @@ def check_cmd(model_file: str) -> None:
     con = console()
     b = model.body
     con.print(f"[bold]{model.name}[/bold]  ({model_file}): valid, schema_version 1")
-    t = Table(title="assembled model", show_header=True)
-    t.add_column("item")
-    t.add_column("value")
+    t = table("assembled model", "item", "value")
     t.add_row("mass", _fmt(b.mass, "kg"))
-    t.add_row("cg from A", str(np.round(b.cg, 6).tolist()) + " m")
-    t.add_row("principal inertia about cg", str(np.round(np.linalg.eigvalsh(b.inertia_cg), 6).tolist()) + " kg m^2")
+    t.add_row("cg from A", _vec(b.cg, "m"))
+    t.add_row("principal inertia about cg", _vec(np.linalg.eigvalsh(b.inertia_cg), "kg m^2"))
     t.add_row("mounts", str(len(model.mounts)))
-    kc = model.elastic_stiffness
-    t.add_row("K_c diagonal", ", ".join(f"{n} {v:.4g}" for n, v in zip(DOF_NAMES, np.diag(kc))))
+    kc = np.diag(model.elastic_stiffness)
+    t.add_row("K_c diagonal", ", ".join(f"{n} {_fmt(v, digits=4)}" for n, v in zip(DOF_NAMES[:3], kc[:3])) + " N/m; "
+              + ", ".join(f"{n} {_fmt(v, digits=4)}" for n, v in zip(DOF_NAMES[3:], kc[3:])) + " N m/rad")
     th = model.thrust
-    t.add_row("thrust", f"point {th.point.tolist()} m, direction {np.round(th.direction, 6).tolist()}, tangency {th.tangency:g}")
-    t.add_row("operating thrust", _fmt(th.operating, "N"))
-    t.add_row("preload stiffness", str(th.preload_stiffness))
+    t.add_row("thrust", f"point {_vec(th.point, 'm')}, direction {_vec(th.direction, '')}".rstrip()
+              + f", tangency {_fmt(th.tangency)}")
+    t.add_row("operating thrust", _fmt(th.operating, "N", missing="not given (thrust.operating): no margins"))
+    t.add_row("preload stiffness", "included" if th.preload_stiffness else "left out")
     p = model.propeller
-    t.add_row("propeller", f"J_p {p.polar_inertia:g} kg m^2, speed {p.speed:g} rad/s ({p.speed_law})")
+    if p.polar_inertia or p.speed:
+        rpm = p.speed * 60.0 / (2.0 * np.pi)
+        t.add_row("propeller", f"J_p {_fmt(p.polar_inertia)} kg m^2, speed {_fmt(p.speed)} rad/s "
+                  f"({_fmt(rpm, digits=5)} rpm), {p.speed_law}")
+    else:
+        t.add_row("propeller", "no spinning propeller")
     fl = model.fluid
-    t.add_row("fluid", fl.model if fl.model == "none" else f"{fl.model}, added mass diag {np.round(np.diag(fl.added_mass), 6).tolist()}")
+    t.add_row("fluid", "none" if fl.model == "none" else
+              f"{fl.model}, added mass diagonal {_vec(np.diag(fl.added_mass), '(kg, kg m^2)')}")
     if fl.model in ("baffled-cylinder", "strip") and model.hull is not None:
         from .. import fluid as _fluid
 
         h = model.hull
         ref = _fluid.strip_theory(radius=h.radius, length=h.length, density=fl.density)
-        ma, ia = fl.added_mass[1, 1], None
         coeffs = (
             _fluid.baffled_cylinder(radius=h.radius, length=h.length, density=fl.density)
             if fl.model == "baffled-cylinder" else ref
         )
         ma, ia = coeffs.added_mass, coeffs.added_inertia
-        t.add_row("added mass m_a", f"{ma:.6g} kg ({ma / ref.added_mass:.4f} x strip theory)")
-        t.add_row("added inertia I_a", f"{ia:.6g} kg m^2 ({ia / ref.added_inertia:.4f} x strip theory)")
-    t.add_row("analysis", f"thrust_max {model.analysis.thrust_max:g} N, linearization {model.analysis.linearization}")
+        t.add_row("added mass m_a", f"{_fmt(ma)} kg ({ma / ref.added_mass:.4f} x strip theory)")
+        t.add_row("added inertia I_a", f"{_fmt(ia)} kg m^2 ({ia / ref.added_inertia:.4f} x strip theory)")
+    t.add_row("analysis", f"thrust_max {_fmt(model.analysis.thrust_max, 'N')}, "
+              f"linearization {model.analysis.linearization}")
     con.print(t)
     md = modes(model, 0.0)
-    con.print("natural frequencies at zero thrust (Hz): " + ", ".join(f"{f:.4g}" for f in md.frequency_hz))
+    con.print("natural frequencies at zero thrust (Hz): " + ", ".join(_fmt(f, digits=4) for f in md.frequency_hz))
+    _static_loads_table(model, con)
+
+
+def _static_loads_table(model, con) -> None:
+    """Static deflection and load of each mount at the operating thrust, with utilisations."""
+    from ..errors import NumericalError
+    from ..response.static import static_mount_loads
+
+    if not model.thrust.operating:
+        con.print("static mount loads: no operating thrust (thrust.operating), so none are reported")
+        return
+    try:
+        st = static_mount_loads(model)
+    except NumericalError as exc:
+        con.print(f"[yellow]warning:[/yellow] static mount loads at the operating thrust: {exc}")
+        return
+    t = table(f"static mount deflection and load at the operating thrust {st.thrust:g} N ({st.linearization})",
+              ("mount", "right"), ("axial d (mm)", "right"), ("shear d (mm)", "right"), ("|d| (mm)", "right"),
+              ("axial F (N)", "right"), ("shear F (N)", "right"), ("|F| (N)", "right"), ("use (%)", "right"))
+    util = st.utilisation
+
+    def part(value: float, whole: float, scale: float, digits: int) -> str:
+        # a component at rounding level of the whole (a shear of 1e-16 mm on an axial mount) is 0
+        return _fmt(0.0 if abs(value) <= 1e-9 * abs(whole) else scale * value, digits=digits)
+
+    for i in range(len(model.mounts)):
+        u = "no rating" if not np.isfinite(util[i]) else (
+            f"[red]{100 * util[i]:.0f}[/red]" if util[i] > 1 else f"{100 * util[i]:.0f}")
+        dm, fm = st.deflection_magnitude[i], st.force_magnitude[i]
+        t.add_row(
+            str(i), part(st.axial_deflection[i], dm, 1e3, 4), part(st.shear_deflection[i], dm, 1e3, 4),
+            _fmt(1e3 * dm, digits=4), part(st.axial_force[i], fm, 1.0, 5), part(st.shear_force[i], fm, 1.0, 5),
+            _fmt(fm, digits=5), u,
+        )
+    con.print(t)
+    con.print("mounts numbered as in `impstab check` above; d: body-end deflection of the attachment from the "
+              "unloaded pose; F: force of the mount on the hull; use: the larger of |F| / rated_force and "
+              "|d| / max_deflection (no rating: neither key given)")
+    for w in st.warnings:
+        con.print(f"[yellow]warning:[/yellow] {w}")
 
 
 @click.command("modes")
@@ -81,33 +127,50 @@ def check_cmd(model_file: str) -> None:
 @click.option("--thrust", type=float, default=0.0, show_default=True, help="thrust T (N)")
 @click.option("--linearization", type=LINEARIZATION, default=None, help="override the model's setting")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json: bool) -> None:
-    """Natural frequencies, damping, growth rates and mode shapes at a thrust."""
-    from rich.table import Table
-
-    from ..linear.modes import modes
+@click.option("--shapes", is_flag=True, help="also print the mode shapes at A")
+def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json: bool, shapes: bool) -> None:
+    """Natural frequencies, damping, growth rates, the decoupling table and mode shapes at a thrust."""
+    from ..display.format import growth
     from ..model.model import DOF_NAMES
+    from ..response.decoupling import decoupling_check
 
     check_number("--thrust", thrust, nonneg=True)
     model = _load(model_file)
+    from ..linear.modes import modes
+
     res = modes(model, thrust, linearization)
+    check = decoupling_check(model, thrust, linearization, modal=res)
     if as_json:
-        print_json(res.to_dict())
+        print_json({**res.to_dict(), "decoupling": check.to_dict()})
         return
-    t = Table(title=f"modes of {model.name} at T = {thrust:g} N ({res.linearization})")
-    for col in ("mode", "f (Hz)", "omega (rad/s)", "zeta", "growth (1/s)", "dominant"):
-        t.add_column(col)
-    for name in DOF_NAMES:
-        t.add_column(f"|{name}|", justify="right")
+    scale = float(np.abs(res.eigenvalues).max(initial=0.0))
+    t = table(f"modes of {model.name} at T = {thrust:g} N ({res.linearization} linearization)",
+              ("mode", "right"), ("f (Hz)", "right"), ("omega (rad/s)", "right"), ("zeta (1)", "right"),
+              ("growth (1/s)", "right"), "dominant dof")
     for j, dom in enumerate(res.dominant()):
-        t.add_row(
-            str(j + 1), f"{res.frequency_hz[j]:.6g}", f"{res.omega[j]:.6g}", f"{res.damping_ratio[j]:.4g}",
-            f"{res.growth_rate[j]:.4g}", ", ".join(dom), *(f"{abs(v):.3f}" for v in res.shapes[:, j]),
-        )
+        t.add_row(str(j + 1), _fmt(res.frequency_hz[j]), _fmt(res.omega[j]),
+                  "0" if abs(res.growth_rate[j]) < 1e-10 * max(scale, 1e-300) else _fmt(res.damping_ratio[j], digits=4),
+                  growth(res.growth_rate[j], scale), "/".join(dom))
     con = console()
     con.print(t)
-    con.print("shapes: displacement of A (m) and rotation (rad), largest component 1; "
+    e = table("decoupling table: kinetic-energy shares of each mode by dof (%)", ("mode", "right"),
+              *((n, "right") for n in DOF_NAMES))
+    for j in range(len(res.eigenvalues)):
+        e.add_row(str(j + 1), *(f"{round(100 * v, 1) + 0.0:.1f}" for v in res.participation[j]))
+    con.print(e)
+    con.print("shares: each dof's part of the mode's kinetic energy in mass-centre coordinates (rows sum to 100); "
+              "dominant: the largest share (with any within 1 point of it); zeta = -growth / |lambda| "
+              "(negative: the mode grows); the complex shapes are in --json and --shapes; "
               + ("stable" if res.stable else "[red]UNSTABLE[/red]"))
+    if shapes:
+        st = table("mode shapes at A: displacement (m) and rotation (rad), largest component 1", ("mode", "right"),
+                   *((f"|{n}|", "right") for n in DOF_NAMES))
+        for j in range(res.shapes.shape[1]):
+            st.add_row(str(j + 1), *(f"{abs(v):.3f}" for v in res.shapes[:, j]))
+        con.print(st)
+    con.print("decoupling")
+    for line in check.lines():
+        con.print("  " + line)
 
 
 @click.command("locus")
@@ -115,51 +178,33 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
 @click.option("--thrust-max", type=float, default=None, help="upper thrust (N); default analysis.thrust_max")
 @click.option("--steps", type=int, default=200, show_default=True, help="thrust intervals")
 @click.option("--linearization", type=LINEARIZATION, default=None)
-@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="netCDF file (.nc); a PNG is written beside it")
-def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearization: str | None, output: str | None) -> None:
-    """Eigenvalue loci against thrust: netCDF data and a PNG like the paper's Figure 4."""
+@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
+              help="netCDF file (.nc; a PNG is written beside it) or a figure only (.png, .svg, .pdf)")
+@figure_options
+def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearization: str | None, output: str | None,
+              figure: str | None, dpi: float | None, no_plot: bool) -> None:
+    """Eigenvalue loci against thrust: netCDF data and a figure like the paper's Figure 4."""
     from ..io import atomic_path
-    from ..linear.critical_thrust import critical_thrust
     from ..linear.locus import locus
 
     check_number("--thrust-max", thrust_max, positive=True)
     if steps < 1 or steps > 100000:
         raise ModelError("--steps", steps, "must be between 1 and 100000")
-    if output is not None and Path(output).suffix.lower() not in (".nc", ".png"):
-        raise ModelError("--output", output, "must end in .nc (netCDF; a PNG is written beside it) or .png")
-    model = _load(model_file)
-    res = locus(model, steps=steps, thrust_max=thrust_max, linearization=linearization)
-    crit = critical_thrust(model, thrust_max=res.thrust[-1], linearization=linearization)
-    from dataclasses import replace
-
-    res = replace(res, critical_thrust=crit.thrust)
     out = Path(output) if output else Path(Path(model_file).stem + "-locus.nc")
-    png = out.with_suffix(".png")
-    if out.suffix.lower() == ".nc":
-        with atomic_path(out) as tmp:
+    data, fig_path = data_and_figure(out, (".nc",), figure, no_plot, dpi)
+    model = _load(model_file)
+    res = locus(model, steps=steps, thrust_max=thrust_max, linearization=linearization, critical=True)
+    if data is not None:
+        with atomic_path(data) as tmp:
             res.to_xarray().to_netcdf(tmp, engine="h5netcdf")
-    _save_png(res, png)
+    if fig_path is not None:
+        draw_and_save(res.plot, fig_path, dpi)
     con = console()
-    con.print(f"critical thrust: {_fmt(crit.thrust, 'N')} ({crit.kind})")
-    if out.suffix.lower() == ".nc":
-        con.print(f"wrote {out} and {png}")
+    if res.critical_thrust is None:
+        con.print(f"critical thrust: none up to {res.thrust[-1]:g} N (stable over the whole range)")
     else:
-        con.print(f"wrote {png}")
-
-
-def _save_png(res, png: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg", force=False) if matplotlib.get_backend().lower() != "agg" else None
-    import matplotlib.pyplot as plt
-
-    from ..io import atomic_path
-
-    axes = res.plot()
-    fig = axes[0].figure
-    with atomic_path(png) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
-    plt.close(fig)
+        con.print(f"critical thrust: {_fmt(res.critical_thrust, 'N')} ({res.critical_kind})")
+    con.print("wrote " + " and ".join(str(p) for p in (data, fig_path) if p is not None))
 
 
 @click.command("critical")
@@ -170,8 +215,7 @@ def _save_png(res, png: Path) -> None:
 @click.option("--all-crossings", is_flag=True, help="also list later losses and gains of stability")
 def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linearization: str | None, all_crossings: bool) -> None:
     """Critical thrust, kind, frequency and margin."""
-    from rich.table import Table
-
+    from ..display.text import critical_rows
     from ..linear.critical_thrust import critical_thrust
 
     check_number("--thrust-max", thrust_max, positive=True)
@@ -180,25 +224,14 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
     if as_json:
         print_json(res.to_dict())
         return
-    t = Table(title=f"critical thrust of {model.name}")
-    t.add_column("quantity")
-    t.add_column("value")
-    if res.thrust is None:
-        t.add_row("critical thrust", f"none up to {res.thrust_max:g} N (stable over the whole range)")
-    else:
-        t.add_row("critical thrust", _fmt(res.thrust, "N", 10))
-        t.add_row("kind", res.kind)
-        t.add_row("frequency", f"{res.frequency_hz:.6g} Hz ({res.omega:.6g} rad/s)")
-        t.add_row("modes involved", ", ".join(res.modes))
-    t.add_row("operating thrust", _fmt(res.operating_thrust, "N"))
-    t.add_row("margin (critical / operating)", _fmt(res.margin, "", 4))
-    t.add_row("undamped critical thrust", _fmt(res.undamped_thrust, "N", 10) + (f" ({res.undamped_kind})" if res.undamped_thrust else ""))
-    t.add_row("linearization", res.linearization)
-    t.add_row("search range", f"0 to {res.thrust_max:g} N")
+    t = table(f"critical thrust of {model.name}", "quantity", "value")
+    for name, value in critical_rows(res, model.is_damped or model.fluid.compressible):
+        t.add_row(name, value)
     for c in res.crossings:
-        t.add_row(f"crossing ({c.direction})", f"{c.load:.10g} N, {c.kind}, {c.omega / (2 * np.pi):.6g} Hz")
+        t.add_row(f"crossing ({c.direction})", f"{c.load:.10g} N, {c.kind}, {fmt(c.omega / (2 * np.pi))} Hz")
     if res.fluid_frequency_hz is not None:
-        t.add_row("fluid coefficients at", f"{res.fluid_frequency_hz:.6g} Hz ({res.fluid_iterations} iterations, last change {res.fluid_change if res.fluid_change is not None else float('nan'):.2e})")
+        change = "" if res.fluid_change is None else f", last change {res.fluid_change:.2e}"
+        t.add_row("fluid coefficients at", f"{_fmt(res.fluid_frequency_hz)} Hz ({res.fluid_iterations} iterations{change})")
     con = console()
     con.print(t)
     for w in res.warnings:

@@ -10,7 +10,8 @@ from pathlib import Path
 import click
 
 from ..errors import ModelError
-from ._common import check_number, print_json
+from ..display.format import growth
+from ._common import check_number, console, data_and_figure, draw_and_save, figure_options, fmt, print_json, table
 
 __all__ = ["commands"]
 
@@ -63,23 +64,10 @@ def _progress(enabled: bool):
                     console=Console(stderr=True), transient=True, disable=not enabled)
 
 
-def _save_png(results, png: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg", force=False) if matplotlib.get_backend().lower() != "agg" else None
-    import matplotlib.pyplot as plt
-
-    from ..io import atomic_path
+def _draw(results):
     from ..plot.simulation import plot_simulations
 
-    if len(results) == 1:
-        axes = results[0].plot()
-        fig = axes[0].figure
-    else:
-        fig = plot_simulations(results)[0, 0].figure
-    with atomic_path(png) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
-    plt.close(fig)
+    return results[0].plot() if len(results) == 1 else plot_simulations(results)
 
 
 def _write(results, out: Path) -> None:
@@ -95,24 +83,36 @@ def _write(results, out: Path) -> None:
 
 
 def _table(results, model_name: str):
-    from rich.table import Table
-
-    t = Table(title=f"time simulation of {model_name}")
-    for col in ("thrust (N)", "class", "envelope", "fitted growth (1/s)", "max Re(λ) (1/s)", "difference",
-                "steps", "run (s)", "status"):
-        t.add_column(col)
+    t = table(f"time simulation of {model_name}", ("thrust (N)", "right"), "class", "envelope",
+              ("fitted\ngrowth (1/s)", "right"), ("max Re λ\n(1/s)", "right"), ("diff.", "right"), "status")
     for r in results:
         g = r.growth
         diff = g.relative_difference if g else None
+        exponential = g is not None and g.envelope in ("exponential growth", "decaying") and math.isfinite(g.rate)
         t.add_row(
-            f"{r.thrust[0]:.6g}", r.classification, g.envelope if g else "-",
-            f"{g.rate:.5g}" if g and math.isfinite(g.rate) else "-",
-            f"{g.linear_rate:.5g}" if g and g.linear_rate is not None else "-",
-            f"{100 * diff:.2f} %" if diff is not None else "-",
-            str(r.steps) if r.steps >= 0 else f"{r.rhs_evaluations} f-evals", f"{r.wall_time:.3g}",
-            "completed" if r.completed else f"[red]stopped[/red]: {r.stop_reason}",
+            fmt(r.thrust[0]), r.classification, g.envelope if g else "no fit",
+            fmt(g.rate, digits=5) if exponential else "n/a",
+            growth(g.linear_rate, r.fastest_omega) if g and g.linear_rate is not None else "not computed",
+            fmt(100 * diff, "%", digits=2) if diff is not None and exponential else "n/a",
+            "completed" if r.completed else "[red]stopped[/red]",
         )
     return t
+
+
+def _notes(results) -> list[str]:
+    lines = ["fitted growth, and its difference from max Re λ: for exponential envelopes only (n/a otherwise)"]
+    steps = ", ".join(str(r.steps) if r.steps >= 0 else f"{r.rhs_evaluations} f-evals" for r in results)
+    lines.append(f"steps: {steps}; run time: {', '.join(fmt(r.wall_time, digits=3) for r in results)} s")
+    lines += [f"T = {r.thrust[0]:.6g} N: {r.stop_reason}" for r in results if not r.completed]
+    for r in results:
+        g = r.growth
+        if g is not None and g.envelope == "limit cycle" and g.amplitude:
+            amps = ", ".join(f"{k} {fmt(v, digits=4)} {'m' if k in ('surge', 'sway', 'heave') else 'rad'}"
+                             for k, v in g.amplitude.items())
+            lines.append(f"T = {r.thrust[0]:.6g} N: limit cycle, period {fmt(g.period, digits=6)} s, amplitude {amps}")
+        if g is not None and g.reason:
+            lines.append(f"T = {r.thrust[0]:.6g} N: {g.envelope}: {g.reason}")
+    return lines
 
 
 @click.command("simulate")
@@ -128,10 +128,12 @@ def _table(results, model_name: str):
 @click.option("--displace", multiple=True, metavar="DOF=VALUE", help="initial displacement (m, rad), repeatable")
 @click.option("--kick", multiple=True, metavar="DOF=VALUE", help="initial velocity (m/s, rad/s), repeatable")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
-              help="netCDF (.nc) or CSV (.csv) file; a PNG of sway and pitch is written beside it")
+              help="netCDF (.nc) or CSV (.csv) file, with a PNG of sway and pitch beside it; "
+                   "or a figure only (.png, .svg, .pdf)")
+@figure_options
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object (settings and outcome of each run)")
 def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, tol, displace, kick, output,
-                 as_json) -> None:
+                 figure, dpi, no_plot, as_json) -> None:
     """Nonlinear time histories of MODEL_FILE from the static equilibrium under thrust.
 
     Writes the time histories (netCDF or CSV) and a PNG of sway and pitch like the paper's
@@ -148,8 +150,7 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     check_number("--sample", sample, positive=True)
     check_number("--tol", tol, positive=True)
     out = Path(output) if output else Path(Path(model_file).stem + "-simulation.nc")
-    if out.suffix.lower() not in (".nc", ".csv"):
-        raise ModelError("--output", output, "must end in .nc (netCDF) or .csv; a PNG is written beside it")
+    data, fig_path = data_and_figure(out, (".nc", ".csv"), figure, no_plot, dpi)
     pert = None
     if displace or kick:
         pert = {"displacement": _dof_values("--displace", displace), "velocity": _dof_values("--kick", kick)}
@@ -169,26 +170,21 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
                                     progress=lambda f, task=task: bar.update(task, completed=f)))
     for w in {str(w.message) for w in caught}:
         click.echo(f"impstab: warning: {w}", err=True)
-    _write(results, out)
-    png = out.with_suffix(".png")
-    _save_png(results, png)
+    if data is not None:
+        _write(results, data)
+    if fig_path is not None:
+        draw_and_save(lambda: _draw(results), fig_path, dpi)
     if as_json:
-        print_json({"runs": [r.to_dict() for r in results], "critical_thrust": crit, "output": str(out),
-                    "figure": str(png)})
+        print_json({"runs": [r.to_dict() for r in results], "critical_thrust": crit,
+                    "output": None if data is None else str(data), "figure": None if fig_path is None else str(fig_path)})
         return
-    from rich.console import Console
-
-    con = Console(highlight=False, width=None if sys.stdout.isatty() else 160)
+    con = console()
     con.print(_table(results, model.name))
-    for r in results:
-        g = r.growth
-        if g is not None and g.envelope == "limit cycle" and g.amplitude:
-            amps = ", ".join(f"{k} {v:.4g} {'m' if k in ('surge', 'sway', 'heave') else 'rad'}" for k, v in g.amplitude.items())
-            con.print(f"T = {r.thrust[0]:.6g} N: limit cycle, period {g.period:.6g} s, amplitude {amps}", markup=False)
-        if g is not None and g.reason:
-            con.print(f"T = {r.thrust[0]:.6g} N: {g.envelope}: {g.reason}", markup=False)
-    con.print(f"critical thrust {crit:.8g} N" if crit is not None else "no critical thrust up to thrust_max")
-    con.print(f"wrote {out} and {png}")
+    for line in _notes(results):
+        con.print(line)
+    con.print(f"critical thrust {crit:.8g} N" if crit is not None
+              else f"no critical thrust up to thrust_max = {model.analysis.thrust_max:g} N")
+    con.print("wrote " + " and ".join(str(p) for p in (data, fig_path) if p is not None))
 
 
 commands = [simulate_cmd]

@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from ..errors import ModelError
-from ._common import console
+from ._common import check_number, console, draw_and_save, fmt, table
 
 __all__ = ["commands"]
 
@@ -23,11 +23,9 @@ class Interrupted(click.ClickException):
 
 
 def _fmt(v, unit: str = "") -> str:
-    if v is None or (isinstance(v, float) and v != v):
-        return "-"
-    if isinstance(v, float):
-        return f"{v:.6g}{(' ' + unit) if unit else ''}"
-    return str(v)
+    if isinstance(v, (bool, str)) or v is None:
+        return "n/a" if v is None else str(v)
+    return fmt(v, unit)
 
 
 @click.command("sweep")
@@ -67,23 +65,22 @@ def sweep_cmd(study_file: str, store: str | None, workers: int | None, scheduler
 
 
 def _summary(res, study, out: Path, elapsed: float, written: list[str]) -> None:
-    from rich.table import Table
+    from ..model.reference import label, unit
 
     counts = res.counts()
-    t = Table(title=f"design study {study.name}: {study.size} designs ({study.method})")
-    t.add_column("quantity")
-    t.add_column("value")
-    t.add_row("parameters", ", ".join(p.name for p in study.parameters))
+    t = table(f"design study {study.name}: {study.size} designs ({study.method})", "quantity", "value")
+    t.add_row("parameters", "; ".join(f"{p.name}: {label(p.name)}" for p in study.parameters))
     t.add_row("designs", ", ".join(f"{k} {v}" for k, v in counts.items() if v or k == "ok"))
     t.add_row("time (this run)", f"{elapsed:.3g} s")
     if counts["ok"]:
-        for by in ("margin", "critical_thrust"):
+        for by, u in (("margin", ""), ("critical_thrust", "N")):
             if by in res.dataset:
                 best = res.best(by)
-                where = ", ".join(f"{k} = {_fmt(v)}" for k, v in best["parameters"].items())
-                text = _fmt(best["value"])
+                where = ", ".join(f"{k} = {_fmt(v, unit(k) if unit(k) not in (None, '1') else '')}"
+                                  for k, v in best["parameters"].items())
+                text = _fmt(best["value"], u)
                 if best["lower_bound"]:
-                    text = f">= {text} (stable up to thrust_max; {best['tied']} such designs)"
+                    text = f">= {text}: {best['warning']},"
                 t.add_row(f"largest {by}", f"{text} at {where}")
                 break
     t.add_row("store", str(out))
@@ -115,26 +112,20 @@ def _parse_at(items: tuple[str, ...]) -> dict[str, object]:
 @click.option("--y", "y", default=None, help="parameter path on the vertical axis (default: the second)")
 @click.option("--value", default="critical_thrust", show_default=True, help="output to colour: critical_thrust, margin, ...")
 @click.option("--at", "at", multiple=True, help="value of another grid parameter, PATH=VALUE (default: its first)")
-@click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), help="PNG file; default STORE-map.png")
-def map_cmd(store: str, x: str | None, y: str | None, value: str, at: tuple[str, ...], output: str | None) -> None:
-    """Draw the stability map of the study in STORE to a PNG."""
-    from ..io import atomic_path
+@click.option("-o", "--output", default=None, type=click.Path(dir_okay=False),
+              help="figure file, .png, .svg or .pdf; default STORE-map.png")
+@click.option("--dpi", type=float, default=None, help="resolution of a PNG figure (default 150; SVG and PDF are vector)")
+def map_cmd(store: str, x: str | None, y: str | None, value: str, at: tuple[str, ...], output: str | None,
+            dpi: float | None) -> None:
+    """Draw the stability map of the study in STORE (PNG, SVG or PDF by the suffix)."""
+    from ..plot.save import check_figure_path
     from ..studies import open_study
 
     out = Path(output) if output else Path(str(Path(store)).rstrip("/\\").removesuffix(".zarr") + "-map.png")
-    if out.suffix.lower() != ".png":
-        raise ModelError("--output", str(out), "must end in .png")
+    check_figure_path(out)
+    check_number("--dpi", dpi, positive=True)
     res = open_study(store)
-    import matplotlib
-
-    if matplotlib.get_backend().lower() != "agg":
-        matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    ax = res.plot(x=x, y=y, value=value, at=_parse_at(at))
-    with atomic_path(out) as tmp:
-        ax.figure.savefig(tmp, format="png", dpi=130)
-    plt.close(ax.figure)
+    draw_and_save(lambda: res.plot(x=x, y=y, value=value, at=_parse_at(at)), out, dpi)
     console().print(f"wrote {out}")
 
 

@@ -164,8 +164,10 @@ class Perturbation:
     velocity : (6,) array or dict by dof
         Initial body-frame velocity of A (m/s) and angular velocity (rad/s), same order.
 
-    The default (:meth:`default`) is a small sway and yaw kick: velocity 1e-5 m/s in sway and
-    1e-5 rad/s in yaw, small enough to stay linear for many e-foldings of a flutter mode.
+    The default (:meth:`default`) is a small sway and pitch kick: velocity 1e-5 m/s in sway and
+    1e-5 rad/s in pitch, small enough to stay linear for many e-foldings of a flutter mode. It
+    starts both planes of a symmetric layout (sway-yaw and heave-pitch), so that sway and pitch
+    both show the flutter mode (the paper's Figures 5-6).
     """
 
     displacement: Sequence[float] | Mapping[str, float] | None = None
@@ -177,7 +179,7 @@ class Perturbation:
 
     @classmethod
     def default(cls) -> "Perturbation":
-        return cls(velocity={"sway": 1e-5, "yaw": 1e-5})
+        return cls(velocity={"sway": 1e-5, "pitch": 1e-5})
 
     @classmethod
     def coerce(cls, value) -> "Perturbation":

@@ -114,7 +114,7 @@ class SimulationResult:
                                         {"units": unit, "long_name": f"{name}: {what}, absolute"})
             data[f"{name}_velocity"] = ("time", self.velocity[:, j],
                                         {"units": vunit, "long_name": f"body-frame velocity {_VELOCITY_NAMES[j]}"})
-        data["thrust"] = ("time", self.thrust, {"units": "N"})
+        data["thrust"] = ("time", self.thrust, {"units": "N", "long_name": "thrust at each sample"})
         data["mount_force"] = (("time", "mount", "axis"), self.mount_loads[:, :, :3],
                                {"units": "N", "long_name": "force of the mount on the body, hull frame"})
         data["mount_moment"] = (("time", "mount", "axis"), self.mount_loads[:, :, 3:],
@@ -137,8 +137,9 @@ class SimulationResult:
             attrs["growth_rate_fit"] = self.growth.rate
             if self.growth.linear_rate is not None:
                 attrs["growth_rate_linear"] = self.growth.linear_rate
-        coords = {"time": ("time", self.time, {"units": "s"}), "mount": np.arange(self.mount_loads.shape[1]),
-                  "axis": ["x", "y", "z"]}
+        coords = {"time": ("time", self.time, {"units": "s", "long_name": "time"}),
+                  "mount": ("mount", np.arange(self.mount_loads.shape[1]), {"units": "1", "long_name": "mount number"}),
+                  "axis": ("axis", ["x", "y", "z"], {"long_name": "hull-frame axis"})}
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     @classmethod
@@ -160,44 +161,69 @@ class SimulationResult:
         return cls(**kw)
 
     def plot(self, ax=None):
-        """Sway (m) and pitch (rad) against time, like the paper's Figures 5-6; returns the axes."""
+        """Sway above pitch against time, like the paper's Figures 5-6.
+
+        ``ax`` may be None (a new figure), one Axes (sway only) or a pair; returns a
+        :class:`~impstab.plot.SimulationAxes` ``(sway, pitch)``, or the one Axes given.
+        """
         from ..plot.simulation import plot_simulation
 
         return plot_simulation(self, ax=ax)
 
     def __repr__(self) -> str:
-        g = self.growth
-        rate = "n/a" if g is None or not math.isfinite(g.rate) else f"{g.rate:.4g} 1/s"
-        state = "completed" if self.completed else f"stopped: {self.stop_reason}"
-        return (f"SimulationResult({self.model_name!r}, {self.integrator}, {self.thrust_history}, "
-                f"{self.time.size} samples, {state}, growth {rate}, {self.classification})")
+        from ..display import simulation_text
+
+        return simulation_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import simulation_html
+
+        return simulation_html(self)
 
 
 def combine_results(results) -> "xarray.Dataset":  # noqa: F821
     """Several runs (e.g. sub-, at and supercritical thrusts) in one dataset along ``case``.
 
     Runs on the same time grid align exactly; a run that stopped early is padded with NaN.
-    Per-run outcomes become variables over ``case``; shared settings stay in ``attrs``.
+    Per-run outcomes become variables over ``case``; shared settings stay in ``attrs``. The
+    thrust of each run (at t = 0, N) is the coordinate ``thrust`` on ``case``, with an index, so
+    that ``ds.sel(thrust=19000.0)`` picks a run (after reading the file back, restore the index
+    with ``ds.set_xindex("thrust")``); the thrust at every sample is ``applied_thrust``. Every
+    variable keeps its units.
     """
     import xarray as xr
 
-    sets = [r.to_xarray() for r in results]
+    sets = []
+    for r in results:
+        ds = r.to_xarray().rename({"thrust": "applied_thrust"})
+        ds.attrs = {}
+        sets.append(ds)
     per_case = {
-        "thrust_case": ("case", [float(r.thrust[0]) for r in results], {"units": "N", "long_name": "thrust at t = 0"}),
-        "classification": ("case", [r.classification for r in results]),
-        "envelope": ("case", [r.growth.envelope if r.growth else "" for r in results]),
-        "growth_rate_fit": ("case", [r.growth.rate if r.growth else np.nan for r in results], {"units": "1/s"}),
+        "classification": ("case", [r.classification for r in results],
+                           {"long_name": "thrust against the critical thrust: subcritical, critical, supercritical"}),
+        "envelope": ("case", [r.growth.envelope if r.growth else "" for r in results],
+                     {"long_name": "shape of the envelope of the motion"}),
+        "growth_rate_fit": ("case", [r.growth.rate if r.growth else np.nan for r in results],
+                            {"units": "1/s", "long_name": "envelope growth rate fitted to the run"}),
         "growth_rate_linear": ("case", [np.nan if r.growth is None or r.growth.linear_rate is None
-                                        else r.growth.linear_rate for r in results], {"units": "1/s"}),
-        "completed": ("case", [int(r.completed) for r in results]),
-        "stop_reason": ("case", [r.stop_reason or "" for r in results]),
+                                        else r.growth.linear_rate for r in results],
+                               {"units": "1/s", "long_name": "max Re(lambda) of the linearization"}),
+        "completed": ("case", [int(r.completed) for r in results],
+                      {"units": "1", "long_name": "1 when the run reached its duration, 0 when it stopped"}),
+        "stop_time": ("case", [np.nan if r.stop_time is None else r.stop_time for r in results],
+                      {"units": "s", "long_name": "time at which a run stopped early (NaN: it completed)"}),
+        "stop_reason": ("case", [r.stop_reason or "" for r in results], {"long_name": "why a run stopped early"}),
     }
-    shared = ("impstab_version", "model_name", "integrator", "dt", "sample", "duration", "perturbation", "convention")
-    keep = {k: v for k, v in sets[0].attrs.items() if k in shared}
-    stripped = [ds.drop_attrs() if hasattr(ds, "drop_attrs") else ds.assign_attrs({}) for ds in sets]
-    out = xr.concat(stripped, dim="case", join="outer", combine_attrs="drop")
-    out = out.assign(per_case).assign_coords(case=np.arange(len(results)))
-    out.attrs = {**keep, "title": f"time simulations of {results[0].model_name} at {len(results)} thrusts"}
+    keep = ("impstab_version", "model_name", "integrator", "dt", "sample", "duration", "perturbation", "convention")
+    first = results[0].to_xarray().attrs
+    out = xr.concat(sets, dim="case", join="outer", combine_attrs="override")
+    out = out.assign(per_case)
+    out = out.assign_coords(
+        case=("case", np.arange(len(results)), {"units": "1", "long_name": "run number"}),
+        thrust=("case", [float(r.thrust[0]) for r in results], {"units": "N", "long_name": "thrust of the run at t = 0"}),
+    ).set_xindex("thrust")
+    out.attrs = {**{k: v for k, v in first.items() if k in keep},
+                 "title": f"time simulations of {results[0].model_name} at {len(results)} thrusts"}
     return out
 
 

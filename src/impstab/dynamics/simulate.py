@@ -117,7 +117,7 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
         slightly so that samples and the end of the run fall on steps.
     perturbation : Perturbation, dict or None
         Initial displacement (m, rad) and velocity (m/s, rad/s) per dof from the equilibrium;
-        default :meth:`Perturbation.default` (a small sway and yaw kick).
+        default :meth:`Perturbation.default` (a small sway and pitch kick).
     sample : float, optional
         Sampling interval of the output (s); default every step (at most ``MAX_SAMPLES`` samples).
     tol : float, optional

@@ -95,6 +95,11 @@ class FluidCoefficients:
     rotational_radiation_resistance: float | None
     error_estimate: float
 
+    def __repr__(self) -> str:
+        from ..display import fluid_coefficients_text
+
+        return fluid_coefficients_text(self)
+
     @property
     def omega(self) -> float:
         """Angular frequency ``2 pi f`` (rad/s)."""

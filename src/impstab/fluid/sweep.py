@@ -28,6 +28,11 @@ class FrequencySweep:
 
     points: tuple[FluidCoefficients, ...]
 
+    def __repr__(self) -> str:
+        from ..display import sweep_text
+
+        return sweep_text(self)
+
     def column(self, name: str) -> NDArray[np.float64]:
         """One coefficient against frequency as a float array (None becomes NaN)."""
         return np.array([_nan(getattr(p, name)) for p in self.points], dtype=float)
@@ -36,6 +41,30 @@ class FrequencySweep:
     def frequency(self) -> NDArray[np.float64]:
         """Frequencies (Hz)."""
         return self.column("frequency")
+
+    def to_xarray(self):
+        """Dataset of every coefficient against ``frequency`` (Hz), each with its unit."""
+        import xarray as xr
+
+        from .. import __version__
+
+        first = self.points[0]
+        units = {"added_mass": ("kg", "transverse added mass m_a"),
+                 "added_inertia": ("kg m^2", "added rotary inertia I_a about the segment centre"),
+                 "radiation_resistance": ("N s/m", "radiation resistance R = Re Z_T"),
+                 "rotational_radiation_resistance": ("N m s", "rotational radiation resistance R_rot = Re Z_R"),
+                 "strip_ratio": ("1", "m_a / (rho pi a^2 L)"),
+                 "inertia_strip_ratio": ("1", "I_a / (rho pi a^2 L^3 / 12)"),
+                 "loss_factor": ("1", "R / (omega m_a)"),
+                 "error_estimate": ("1", "relative error estimate")}
+        data = {name: ("frequency", self.column(name), {"units": u, "long_name": text})
+                for name, (u, text) in units.items()}
+        attrs = {"title": f"{first.model} coefficients, a = {first.radius:g} m, L = {first.length:g} m",
+                 "model": first.model, "radius_m": first.radius, "length_m": first.length,
+                 "density_kg_m3": first.density, "impstab_version": __version__}
+        if first.sound_speed is not None:
+            attrs["sound_speed_m_s"] = first.sound_speed
+        return xr.Dataset(data, coords={"frequency": ("frequency", self.frequency, {"units": "Hz"})}, attrs=attrs)
 
     def to_dict(self) -> dict[str, Any]:
         """Settings plus one list per coefficient (``None`` where a value does not exist)."""
@@ -62,6 +91,12 @@ class FrequencySweep:
         -------
         matplotlib.figure.Figure
         """
+        from ..plot.style import figure_style
+
+        with figure_style():
+            return self._draw(axes)
+
+    def _draw(self, axes):
         if axes is None:
             from matplotlib.figure import Figure
 

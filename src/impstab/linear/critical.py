@@ -102,6 +102,11 @@ class CriticalLoad:
     evaluations: int = 0
     warnings: tuple[str, ...] = field(default_factory=tuple)
 
+    def __repr__(self) -> str:
+        from ..display import critical_load_text
+
+        return critical_load_text(self)
+
     @property
     def frequency_hz(self) -> float | None:
         return None if self.omega is None else self.omega / (2.0 * np.pi)

@@ -72,6 +72,16 @@ class CriticalThrust:
     fluid_change: float | None = None
     warnings: tuple[str, ...] = ()
 
+    def __repr__(self) -> str:
+        from ..display import critical_text
+
+        return critical_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import critical_html
+
+        return critical_html(self)
+
     @property
     def frequency_hz(self) -> float | None:
         """Onset frequency ``omega / 2 pi`` (Hz)."""

@@ -47,6 +47,11 @@ class ModalForm:
     truncated: bool
     _family: ModelFamily
 
+    def __repr__(self) -> str:
+        from ..display import modal_form_text
+
+        return modal_form_text(self)
+
     def gyroscopic(self, thrust: float) -> Array:
         """Modal gyroscopic matrix ``Phi^T G(P) Phi`` (propeller speed may follow the thrust)."""
         _, _, g, _ = self._family.matrices(np.array([thrust]))

@@ -1,4 +1,19 @@
-"""Natural frequencies, damping, growth rates and mode shapes at one thrust."""
+"""Natural frequencies, damping, growth rates, mode shapes and the mode decoupling table at one thrust.
+
+The decoupling table (``ModalResult.participation``) is the kinetic-energy distribution an NVH
+engineer uses to judge a mount layout: for mode ``x`` (shape at A) and dof ``j``,
+
+    share_j = Re(conj(y_j) (M_c y)_j) / Re(y^H M_c y),     y = T6(c) x,  M_c = T6(c)^-T M T6(c)^-1,
+
+in the coordinates of the mass centre ``c`` (translation of ``c`` and rotation, hull axes), so that
+a rotation about the cg counts as rotation and not as translation of an arbitrary datum. Each row
+sums to 1 exactly (Jeong and Singh's energy distribution, J. Sound Vib. 234 (2000) 85-114). The
+mass centre is the point where the translation-rotation coupling of ``M`` is symmetric
+(:func:`coupling_centre`): the cg for a dry body, where the rigid-body coupling vanishes; with
+added mass the inertial centre of body and entrained water. A share can be slightly negative or
+above 1 where ``M_c`` keeps off-diagonal terms (products of inertia, added mass off the cg); the
+row still sums to 1. The dominant dof of a mode is its largest share.
+"""
 
 from __future__ import annotations
 
@@ -9,11 +24,10 @@ from numpy.typing import NDArray
 
 from ..model.model import DOF_NAMES, Model
 from .critical import TOL_DUPLICATE
-from .eigen import kinetic_shares
 from .linearize import linearize
 from .system import LinearSystem
 
-__all__ = ["ModalResult", "modes", "modes_of_system"]
+__all__ = ["ModalResult", "modes", "modes_of_system", "coupling_centre", "energy_shares"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -28,9 +42,10 @@ class ModalResult:
     eigenvalues : (k,) complex
         ``lambda = sigma + i omega`` (1/s).
     shapes : (6, k) complex
-        Displacement shapes, largest component 1.
+        Displacement shapes at A (m, rad), largest component 1.
     participation : (k, 6)
-        Kinetic-energy share of each dof in each mode.
+        The mode decoupling table: kinetic-energy share of each dof in each mode, in the
+        coordinates of the mass centre (rows sum to 1; see the module notes).
     """
 
     thrust: float
@@ -38,6 +53,16 @@ class ModalResult:
     eigenvalues: NDArray[np.complex128]
     shapes: NDArray[np.complex128]
     participation: NDArray[np.float64]
+
+    def __repr__(self) -> str:
+        from ..display import modal_text
+
+        return modal_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import modal_html
+
+        return modal_html(self)
 
     @property
     def omega(self) -> NDArray[np.float64]:
@@ -64,9 +89,19 @@ class ModalResult:
         scale = max(np.abs(self.eigenvalues).max(), 1e-300)
         return bool(np.all(self.growth_rate <= 1e-9 * scale))
 
-    def dominant(self, threshold: float = 0.2) -> list[tuple[str, ...]]:
-        """Dof names carrying at least ``threshold`` of each mode's kinetic energy."""
-        return [tuple(n for n, s in zip(DOF_NAMES, row) if s >= threshold) for row in self.participation]
+    def dominant(self, tie: float = 0.01) -> list[tuple[str, ...]]:
+        """The dof with the largest kinetic-energy share in each mode (the decoupling table's
+        maximum), with any other dof within ``tie`` of it (a whirl mode of a symmetric, spinning
+        layout shares its energy equally between two planes), largest first."""
+        out = []
+        for row in self.participation:
+            order = np.argsort(-row, kind="stable")
+            out.append(tuple(DOF_NAMES[j] for j in order if row[j] >= row[order[0]] - tie))
+        return out
+
+    def decoupling_table(self) -> dict[str, list[float]]:
+        """Kinetic-energy shares in percent, ``{dof: [share of mode 1, ...]}`` (rows sum to 100)."""
+        return {n: (100.0 * self.participation[:, j]).tolist() for j, n in enumerate(DOF_NAMES)}
 
     def to_dict(self) -> dict:
         return {
@@ -79,6 +114,7 @@ class ModalResult:
                     "growth_rate": float(self.growth_rate[j]),
                     "damping_ratio": float(self.damping_ratio[j]),
                     "dominant": list(self.dominant()[j]),
+                    "energy_share": dict(zip(DOF_NAMES, map(float, self.participation[j]))),
                     "shape_real": self.shapes[:, j].real.tolist(),
                     "shape_imag": self.shapes[:, j].imag.tolist(),
                 }
@@ -99,11 +135,42 @@ class ModalResult:
                 "damping_ratio": ("mode", self.damping_ratio, {"units": "1"}),
                 "shape_real": (("dof", "mode"), self.shapes.real),
                 "shape_imag": (("dof", "mode"), self.shapes.imag),
-                "participation": (("mode", "dof"), self.participation),
+                "participation": (("mode", "dof"), self.participation, {
+                    "units": "1", "long_name": "kinetic-energy share of each dof (mass-centre coordinates)"}),
             },
             coords={"mode": np.arange(len(self.eigenvalues)), "dof": list(DOF_NAMES)},
             attrs={"thrust": self.thrust, "linearization": self.linearization, "impstab_version": __version__},
         )
+
+
+def coupling_centre(matrix6: NDArray) -> NDArray:
+    """The point ``p`` (m, from A) about which the translation-rotation coupling block is symmetric.
+
+    Moving the reference point of a symmetric 6 x 6 matrix ``[[A, C], [C^T, B]]`` (mass or
+    stiffness about A) to ``p`` turns its coupling block into ``A S(p) + C``; its skew part
+    vanishes at ``p = -2 (tr(A) I - A)^-1 axial(C - C^T) / 2``, unique for ``A`` positive definite.
+    For a rigid body's mass matrix this is the cg (the coupling vanishes there); for a mount
+    system's stiffness it is the elastic centre (centre of stiffness).
+    """
+    m = np.asarray(matrix6, dtype=float)
+    a, c = m[:3, :3], m[:3, 3:]
+    skew_c = 0.5 * (c - c.T)
+    axial = np.array([skew_c[2, 1], skew_c[0, 2], skew_c[1, 0]])
+    return -2.0 * np.linalg.solve(np.trace(a) * np.eye(3) - a, axial)
+
+
+def energy_shares(shapes: NDArray, mass: NDArray) -> NDArray:
+    """Decoupling table ``(k, 6)`` of the shapes ``(6, k)`` (at A) in mass-centre coordinates."""
+    from ..kinematics import rigid_map6
+
+    centre = coupling_centre(mass)
+    t = rigid_map6(centre)
+    w = np.linalg.inv(t)
+    m_c = w.T @ mass @ w
+    y = t @ np.asarray(shapes, dtype=complex)
+    parts = (y.conj() * (m_c @ y)).real            # (6, k)
+    total = parts.sum(axis=0)
+    return (parts / np.where(total > 0, total, 1.0)).T
 
 
 def _undamped_eigenpairs(system: LinearSystem):
@@ -171,7 +238,7 @@ def modes_of_system(system: LinearSystem) -> ModalResult:
     big = np.argmax(np.abs(vecs), axis=0)
     piv = vecs[big, np.arange(vecs.shape[1])]
     shapes = vecs / piv
-    part = np.array([kinetic_shares(shapes[:, [j]], system.M) for j in range(shapes.shape[1])])
+    part = energy_shares(shapes, system.M)
     return ModalResult(system.thrust, system.linearization, vals, shapes, part)
 
 

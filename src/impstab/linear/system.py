@@ -43,6 +43,11 @@ class LinearSystem:
     displacement: Array
     rotation: Array
 
+    def __repr__(self) -> str:
+        from ..display import linear_system_text
+
+        return linear_system_text(self)
+
     def state_matrix(self) -> Array:
         """``A = [[0, I], [-M^-1 K, -M^-1 (D + G)]]`` for ``x = (q, q')``."""
         return state_matrices(self.M, self.D + self.G, self.K)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -15,10 +16,13 @@ from pydantic import ValidationError
 
 from ..errors import ModelError
 from .body import RigidBody
+from .isolation_specs import excitation_from_spec, foundation_from_spec
 from .fluid import FluidLoading, Hull
 from .model import AnalysisSettings, Model
 from .mounts import Mount, NonlinearLaw, axial_shear_matrix, elastic_stiffness, ring_positions
+from .reference import DOC_PATH
 from .schema import ModelFile
+from .schema_doc import clean_loc, unknown_key_rule
 from .thrust import Propeller, Thrust
 
 __all__ = ["load_model", "model_from_dict", "format_location", "unit_vector"]
@@ -48,16 +52,18 @@ def _lookup(data: Any, loc: tuple) -> Any:
 
 
 def _from_validation_error(err: ValidationError, data: Any) -> ModelError:
-    first = err.errors()[0]
-    loc = tuple(p for p in first["loc"] if not (isinstance(p, str) and p.startswith(("list[", "function-"))))
-    # drop union-branch labels pydantic inserts, e.g. "list[float]"
+    errors = err.errors()
+    # an unknown key is a typo: report it first (pydantic lists the key it hides as missing first)
+    first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
+    loc = clean_loc(ModelFile, tuple(first["loc"]))
     field = format_location(loc)
     value = first.get("input", _lookup(data, loc))
     kind = first["type"]
     if kind == "extra_forbidden":
-        return ModelError(field, value, "unknown key (check the spelling against the model-file schema)")
+        where = f"in {format_location(loc[:-1])}" if len(loc) > 1 else "at the top level"
+        return ModelError(field, value, unknown_key_rule(ModelFile, loc, where, DOC_PATH))
     if kind == "missing":
-        return ModelError(field, None, "is required")
+        return ModelError(field, None, f"is required (see {DOC_PATH})")
     ctx = first.get("ctx") or {}
     if kind in ("too_short", "too_long") and "actual_length" in ctx:
         want = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
@@ -149,14 +155,16 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             axis = unit_vector(m.axis, f"{f}.axis")
             c6 = np.zeros((6, 6))
             c6[:3, :3] = axial_shear_matrix(axis, m.c_axial, m.c_shear)
-        mounts.append(Mount(pos, k6, c6, law))
+        mounts.append(Mount(pos, k6, c6, unit_vector(m.axis, f"{f}.axis"), m.rated_force, m.max_deflection,
+                            nonlinear=law))
     for i, ring in enumerate(doc.mount_rings):
         f = f"mount_rings[{i}]"
         axis = unit_vector(ring.axis, f"{f}.axis")
         law = _nonlinear_law(ring, axis, f)
         for pos in ring_positions(ring.count, ring.radius, ring.x, ring.start_angle):
             mount = Mount.axial_shear(pos, axis, ring.k_axial, ring.k_shear, ring.c_axial, ring.c_shear)
-            mounts.append(Mount(mount.position, mount.stiffness, mount.damping, law))
+            mounts.append(replace(mount, rated_force=ring.rated_force, max_deflection=ring.max_deflection,
+                                  nonlinear=law))
     if not mounts:
         raise ModelError("mounts", [], "the model needs at least one mount or mount ring")
     kc = elastic_stiffness(mounts)
@@ -196,6 +204,15 @@ def _fluid(doc: ModelFile) -> tuple[FluidLoading, Hull | None]:
     return FluidLoading.from_hull(spec.model, hull, spec.density, spec.sound_speed), hull
 
 
+def _spin_speed(spec) -> float:
+    """Propeller speed (rad/s) from ``speed`` (rad/s) or ``speed_rpm`` (rpm), which are exclusive."""
+    if spec.speed_rpm is None:
+        return spec.speed
+    if "speed" in spec.model_fields_set:
+        raise ModelError("propeller.speed_rpm", spec.speed_rpm, "give either speed (rad/s) or speed_rpm (rpm), not both")
+    return spec.speed_rpm * (2.0 * np.pi / 60.0)
+
+
 def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
     b = doc.body
     inertia = _inertia(b.inertia, "body.inertia")
@@ -208,7 +225,7 @@ def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
     )
     prop = doc.propeller or Propeller()
     if doc.propeller is not None:
-        prop = Propeller(doc.propeller.polar_inertia, doc.propeller.speed, doc.propeller.speed_law)
+        prop = Propeller(doc.propeller.polar_inertia, _spin_speed(doc.propeller), doc.propeller.speed_law)
         if prop.speed_law == "sqrt-thrust" and t.operating is None:
             raise ModelError("propeller.speed_law", "sqrt-thrust", "needs thrust.operating (the speed is given at the operating thrust)")
     thrust_max = doc.analysis.thrust_max
@@ -221,6 +238,7 @@ def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
         body=body, mounts=mounts, thrust=thrust,
         analysis=AnalysisSettings(float(thrust_max), doc.analysis.linearization),
         propeller=prop, fluid=fluid, hull=hull, name=name, source=source,
+        excitation=excitation_from_spec(doc.excitation, prop), foundation=foundation_from_spec(doc.foundation),
     )
 
 

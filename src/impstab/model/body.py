@@ -41,6 +41,11 @@ class RigidBody:
     cg: Array
     inertia_cg: Array
 
+    def __repr__(self) -> str:
+        from ..display import body_text
+
+        return body_text(self)
+
     def __post_init__(self) -> None:
         object.__setattr__(self, "cg", _frozen(self.cg))
         object.__setattr__(self, "inertia_cg", _frozen(self.inertia_cg))

@@ -30,6 +30,11 @@ class Hull:
     length: float
     center: Array
 
+    def __repr__(self) -> str:
+        from ..display import hull_text
+
+        return hull_text(self)
+
     def __post_init__(self) -> None:
         c = np.array(self.center, dtype=float)
         c.setflags(write=False)
@@ -66,6 +71,11 @@ class FluidLoading:
     sound_speed: float | None = None
     added_mass: Array = None  # type: ignore[assignment]
     hull: Hull | None = None
+
+    def __repr__(self) -> str:
+        from ..display import fluid_loading_text
+
+        return fluid_loading_text(self)
 
     def __post_init__(self) -> None:
         a = np.zeros((6, 6)) if self.added_mass is None else np.array(self.added_mass, dtype=float)

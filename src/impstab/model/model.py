@@ -8,7 +8,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .body import RigidBody
+from .excitation import Excitation
 from .fluid import FluidLoading, Hull
+from .foundation import Foundation
 from .mounts import Mount, elastic_stiffness, mount_damping
 from .thrust import Propeller, Thrust
 
@@ -54,6 +56,18 @@ class Model:
     hull: Hull | None = None
     name: str = "model"
     source: str | None = None
+    excitation: Excitation = field(default_factory=Excitation)
+    foundation: Foundation = field(default_factory=Foundation)
+
+    def __repr__(self) -> str:
+        from ..display import model_text
+
+        return model_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import model_html
+
+        return model_html(self)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mounts", tuple(self.mounts))

@@ -119,6 +119,12 @@ class Mount:
         Stiffness of the body end, hull frame: ``[f; m] = -stiffness @ [d; phi]`` (N/m, N, N m/rad).
     damping : (6, 6) array
         Viscous damping of the body end, same layout (N s/m, ...).
+    axis : (3,) array
+        Unit mount axis, hull frame (default x): splits deflections and forces into axial and
+        shear parts.
+    rated_force, max_deflection : float or None
+        Static force rating (N) and static deflection limit (m) of the mount, for the static
+        load check (:func:`impstab.response.static_mount_loads`).
     nonlinear : NonlinearLaw or None
         Cubic springs and snubber acting on the translation deflection, in addition to
         ``stiffness``; None (or a linear law): the mount is linear.
@@ -127,12 +133,22 @@ class Mount:
     position: Array
     stiffness: Array
     damping: Array
+    axis: Array = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    rated_force: float | None = None
+    max_deflection: float | None = None
     nonlinear: NonlinearLaw | None = None
+
+    def __repr__(self) -> str:
+        from ..display import mount_text
+
+        return mount_text(self)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", _frozen(self.position))
         object.__setattr__(self, "stiffness", _frozen(self.stiffness))
         object.__setattr__(self, "damping", _frozen(self.damping))
+        axis = np.asarray(self.axis, dtype=float)
+        object.__setattr__(self, "axis", _frozen(axis / np.linalg.norm(axis)))
 
     @classmethod
     def axial_shear(
@@ -155,7 +171,7 @@ class Mount:
         k[:3, :3] = axial_shear_matrix(axis, k_axial, k_shear)
         c[:3, :3] = axial_shear_matrix(axis, c_axial, c_shear)
         law = NonlinearLaw(np.asarray(axis, float), k3_axial, k3_shear, snubber_clearance, snubber_stiffness)
-        return cls(np.asarray(position, float), k, c, None if law.is_linear else law)
+        return cls(np.asarray(position, float), k, c, axis, nonlinear=None if law.is_linear else law)
 
     @property
     def is_nonlinear(self) -> bool:

@@ -56,6 +56,8 @@ class MountSpec(_Strict):
     c_shear: NonNegative = 0.0
     stiffness: Optional[Mat6] = None
     damping: Optional[Mat6] = None
+    rated_force: Optional[Positive] = None      # N, static force rating (isolation design)
+    max_deflection: Optional[Positive] = None   # m, static deflection limit
     # nonlinear mount law (axial-shear mounts only; see impstab.model.mount_law)
     k3_axial: Finite = 0.0
     k3_shear: Finite = 0.0
@@ -73,6 +75,8 @@ class MountRingSpec(_Strict):
     k_shear: NonNegative
     c_axial: NonNegative = 0.0
     c_shear: NonNegative = 0.0
+    rated_force: Optional[Positive] = None      # N, static force rating (isolation design)
+    max_deflection: Optional[Positive] = None   # m, static deflection limit
     # nonlinear mount law (see impstab.model.mount_law)
     k3_axial: Finite = 0.0
     k3_shear: Finite = 0.0
@@ -91,12 +95,62 @@ class ThrustSpec(_Strict):
 class PropellerSpec(_Strict):
     polar_inertia: NonNegative = 0.0
     speed: Finite = 0.0
+    speed_rpm: Optional[Finite] = None  # rpm, instead of speed (rad/s)
     speed_law: Literal["constant", "sqrt-thrust"] = "constant"
 
 
 class AnalysisSpec(_Strict):
     thrust_max: Optional[Positive] = None
     linearization: Literal["equilibrium", "classical"] = "equilibrium"
+
+
+# -- forced response and isolation (docs/isolation.md) ------------------------------------------
+DofName = Literal["surge", "sway", "heave", "roll", "pitch", "yaw"]
+Count = Annotated[int, Field(ge=1, le=1000, strict=True)]
+Table = Annotated[list[NonNegative], Field(min_length=1, max_length=100000)]
+Rows6 = Annotated[list[Row6], Field(min_length=1, max_length=100000)]
+Values = Annotated[list[Finite], Field(max_length=100000)]
+
+
+class UnbalanceSpec(_Strict):
+    mass: Positive                      # kg, unbalance mass m
+    eccentricity: Positive              # m, its radius e: force m e Omega^2 at shaft rate
+    point: Optional[Vec3] = None        # m, body frame; default thrust.point
+    phase_deg: Finite = 0.0             # deg, angle at t = 0 in the plane normal to the thrust axis
+
+
+class BladeRateSpec(_Strict):
+    blades: Count                       # blade count Z: frequency harmonic * Z * Omega / 2 pi
+    harmonic: Count = 1
+    amplitude: Row6                     # N, N m: force and moment at `point`, body axes
+    phase_deg: Row6 = [0.0] * 6         # deg, per component
+    point: Optional[Vec3] = None        # m, body frame; default thrust.point
+
+
+class SpectrumSpec(_Strict):
+    frequency_hz: Table                 # Hz, one harmonic line per row
+    amplitude: Rows6                    # N, N m per row: force and moment at `point`, body axes
+    phase_deg: Optional[Rows6] = None   # deg per row and component; default 0
+    point: Vec3 = [0.0, 0.0, 0.0]       # m, body frame; default A
+
+
+class ExcitationSpec(_Strict):
+    input: DofName = "sway"             # dof of the unit load of `impstab response` (its --input)
+    unbalance: list[UnbalanceSpec] = []
+    blade_rate: list[BladeRateSpec] = []
+    spectrum: Optional[SpectrumSpec] = None
+
+
+class FoundationSpec(_Strict):
+    model: Literal["rigid", "lumped", "mobility-table", "impedance-table"] = "rigid"
+    mass: NonNegative = 0.0             # kg      (lumped: Z = damping + i (w mass - stiffness / w))
+    stiffness: NonNegative = 0.0        # N/m     (lumped)
+    damping: NonNegative = 0.0          # N s/m   (lumped)
+    frequency_hz: Optional[Table] = None            # Hz (tables), strictly increasing
+    mobility_real: Optional[Values] = None    # m/(N s) (mobility-table)
+    mobility_imag: Optional[Values] = None
+    impedance_real: Optional[Values] = None   # N s/m (impedance-table)
+    impedance_imag: Optional[Values] = None
 
 
 class ModelFile(_Strict):
@@ -112,6 +166,8 @@ class ModelFile(_Strict):
     thrust: ThrustSpec = ThrustSpec()
     propeller: Optional[PropellerSpec] = None
     analysis: AnalysisSpec = AnalysisSpec()
+    excitation: Optional[ExcitationSpec] = None   # forced response: loads (docs/isolation.md)
+    foundation: Optional[FoundationSpec] = None   # forced response: compliant hull at the mounts
 
     @field_validator("schema_version")
     @classmethod

@@ -38,6 +38,11 @@ class Thrust:
     operating: float | None = None
     preload_stiffness: bool = True
 
+    def __repr__(self) -> str:
+        from ..display import thrust_text
+
+        return thrust_text(self)
+
     def __post_init__(self) -> None:
         p = np.array(self.point, dtype=float)
         d = np.array(self.direction, dtype=float)

@@ -32,6 +32,30 @@ class StudyResult:
     dataset: Any
     store: str | None = None
 
+    def __repr__(self) -> str:
+        from ..display import study_text
+
+        return study_text(self)
+
+    def _repr_html_(self) -> str:
+        from ..display import study_html
+
+        return study_html(self)
+
+    def __post_init__(self) -> None:
+        # parameter coordinates carry the units of their model-file keys
+        from ..model.reference import label, unit
+
+        ds = self.dataset
+        for p in json.loads(ds.attrs.get("parameters", "[]")):
+            if p in ds.coords and "units" not in ds[p].attrs:
+                u = unit(p)
+                if u is not None:
+                    ds[p].attrs["units"] = u
+                    ds[p].attrs.setdefault("label", label(p))
+        if "sample" in ds.coords and "units" not in ds["sample"].attrs:
+            ds["sample"].attrs["units"] = "1"
+
     @classmethod
     def from_store(cls, st) -> "StudyResult":
         return cls(st.load_dataset(), None if st.path is None else str(st.path))
@@ -69,7 +93,11 @@ class StudyResult:
 
         A design that stays stable over the whole search (kind ``"none"``) has no critical
         thrust; it ranks with its search limit (``thrust_max``, or ``thrust_max / operating`` for
-        the margin) as a lower bound, and the answer says so (``"lower_bound": True``).
+        the margin) as a lower bound, and the answer says so (``"lower_bound": True`` and a
+        ``"warning"``: the true value is larger than shown). Designs that share that bound are a
+        tie that the study cannot break (``"tied"``). A selection (``where``) that leaves out
+        designs stable up to a limit above the value found says so as well: the value is then
+        the largest of the selection only, often just an artefact of the cut-off.
 
         Parameters
         ----------
@@ -85,7 +113,9 @@ class StudyResult:
         dict
             ``parameters`` (path -> value), ``value`` (of ``by``, or its lower bound), ``values``
             (every stored output), ``index`` (position in the design array), ``lower_bound`` and
-            ``tied`` (number of designs sharing the value).
+            ``tied`` (number of designs sharing the value), ``censored_left_out`` (designs outside
+            ``where`` stable up to a limit at or above ``value``: larger than it) and ``warning``
+            (a sentence when the value is a bound, a tie or a cut-off artefact; else None).
         """
         ds = self.dataset
         if by not in ds.data_vars or ds[by].dtype.kind != "f":
@@ -99,9 +129,12 @@ class StudyResult:
             if limit is not None:
                 value = np.where(stable, limit, value)
                 bound = stable
+        bounds_all = np.where(bound, value, np.nan)
         if where is not None:
             mask = where.broadcast_like(ds[by]).transpose(*ds[by].dims).values if hasattr(where, "dims") else np.asarray(where)
-            value = np.where(np.broadcast_to(mask, value.shape), value, np.nan)
+            mask = np.broadcast_to(mask, value.shape)
+            value = np.where(mask, value, np.nan)
+            bound = bound & mask
         if not np.isfinite(value).any():
             raise ModelError("by", by, "no computed (and selected) design has a value for it")
         pick = np.where(np.isfinite(value), value, np.inf if minimum else -np.inf)
@@ -114,14 +147,37 @@ class StudyResult:
         for v in ("kind", "undamped_kind"):
             if v in ds:
                 values[v] = self.kind_names(v).isel(sel).item()
+        chosen, tied = float(value[idx]), int(np.count_nonzero(pick == pick[idx]))
+        left_out, floor = 0, np.nan
+        if not minimum:
+            with np.errstate(invalid="ignore"):
+                better = np.isfinite(bounds_all) & ~np.isfinite(value) & (bounds_all >= chosen)
+            left_out = int(np.count_nonzero(better))
+            floor = float(bounds_all[better].min()) if left_out else np.nan
         return {
             "parameters": params,
-            "value": float(value[idx]),
+            "value": chosen,
             "values": values,
             "index": {d: int(i) for d, i in sel.items()},
             "lower_bound": bool(bound[idx]),
-            "tied": int(np.count_nonzero(pick == pick[idx])),
+            "tied": tied,
+            "censored_left_out": left_out,
+            "warning": _best_warning(by, chosen, bool(bound[idx]), tied, left_out, floor),
         }
+
+    def statistics(self, target_margin: float | None = 1.0, **kw):
+        """Uncertainty statistics of a random, Sobol or Saltelli study: distributions of the
+        critical thrust and margin with censoring at ``thrust_max``, the probability of a margin
+        below ``target_margin``, Sobol indices (:func:`impstab.studies.statistics.study_statistics`)."""
+        from .statistics import study_statistics
+
+        return study_statistics(self, target_margin, **kw)
+
+    def sensitivity(self, quantity: str | None = None, **kw):
+        """Sobol sensitivity indices (:func:`impstab.studies.sensitivity.sensitivity_indices`)."""
+        from .sensitivity import sensitivity_indices
+
+        return sensitivity_indices(self, quantity, **kw)
 
     def operating_thrust(self):
         """Operating thrust of every design (N), an array shaped like the designs; None if unset."""
@@ -221,6 +277,21 @@ class StudyResult:
         if suffix == ".csv":
             return self.to_csv(path)
         raise ModelError("--export", str(path), "must end in .nc (netCDF) or .csv")
+
+
+def _best_warning(by: str, value: float, bound: bool, tied: int, left_out: int, floor: float) -> str | None:
+    """What :meth:`StudyResult.best` must say about a value set by the end of the search."""
+    name = by.replace("_", " ")
+    if bound:
+        text = f"stable up to thrust_max: the true {name} is larger than shown"
+        if tied > 1:
+            text += f"; a tie: {tied} designs are stable up to the same limit and cannot be ranked, this is the first"
+        return text
+    if left_out:
+        return (f"{left_out} designs left out by the selection are stable up to thrust_max, with {name}s of at least "
+                f"{floor:.6g}: {value:.6g} is the largest of the selection only, set by the end of the search; "
+                "raise analysis.thrust_max to rank them")
+    return None
 
 
 def _plain(v):

@@ -4,6 +4,15 @@ Grid: each parameter has its own axis of values and the designs are their Cartes
 Random and Sobol: ``n`` points of the unit hypercube (``numpy.random.default_rng(seed)`` or
 ``scipy.stats.qmc.Sobol(scramble=True, seed=seed)``) mapped through each parameter's inverse
 distribution function, so that the samples are reproducible from the study file alone.
+
+Saltelli: the cross-sampled design of Saltelli (2002) for first-order and total Sobol indices,
+drawn by SALib (``SALib.sample.sobol.sample`` on the unit hypercube, scrambled, without the
+second-order rows) and mapped like the others. ``n`` base samples give ``n * (d + 2)`` designs
+for ``d`` parameters, in SALib's order: for each base sample ``j`` the row of matrix A, the ``d``
+rows ``AB_i`` (A with column ``i`` taken from B), then the row of B. The design's order is the
+order of the ``sample`` dimension of the study, so that the indices can be computed from the
+store alone (:mod:`impstab.studies.sensitivity`). The rows of A and of B are each ``n`` scrambled
+Sobol points of the input distribution.
 """
 
 from __future__ import annotations
@@ -16,7 +25,7 @@ from numpy.typing import NDArray
 
 from .schema import DistributionSpec, ParameterSpec, RangeSpec
 
-__all__ = ["axis_values", "unit_samples", "map_samples", "check_distribution"]
+__all__ = ["axis_values", "unit_samples", "map_samples", "check_distribution", "design_count", "saltelli_rows"]
 
 #: unit-cube coordinates are kept this far from 0 and 1 (inverse CDFs are infinite there)
 _EDGE = 1e-12
@@ -42,7 +51,7 @@ def check_distribution(spec: ParameterSpec) -> None:
         raise ValueError("give either values (a range or a list) or a distribution, not both or neither")
     if isinstance(spec.values, RangeSpec):
         if spec.values.num is not None:
-            raise ValueError("num: is only used with grid sampling (random and sobol draw sampling.n values)")
+            raise ValueError("num: is only used with grid sampling (random, sobol and saltelli draw their own values)")
         if spec.values.stop <= spec.values.start:
             raise ValueError("stop must be greater than start")
         if spec.values.scale == "log" and spec.values.start <= 0:
@@ -67,9 +76,34 @@ def check_distribution(spec: ParameterSpec) -> None:
         raise ValueError("low must be > 0 for a loguniform distribution")
 
 
+def design_count(method: str, n: int, dim: int) -> int:
+    """Number of designs of ``n`` samples of ``dim`` parameters: ``n``, or ``n * (dim + 2)`` for
+    Saltelli's design (``n`` base samples)."""
+    return n * (dim + 2) if method == "saltelli" else n
+
+
+def saltelli_rows(size: int, dim: int) -> dict[str, NDArray[np.int64]]:
+    """Positions of the rows of Saltelli's design of ``size`` designs and ``dim`` parameters:
+    ``"A"`` and ``"B"`` (``(n,)`` each) and ``"AB"`` (``(n, dim)``: column ``i`` holds the rows
+    of A with parameter ``i`` taken from B)."""
+    step = dim + 2
+    if size % step:
+        raise ValueError(f"{size} designs are not a Saltelli design of {dim} parameters (a multiple of {step})")
+    base = np.arange(0, size, step, dtype=np.int64)
+    return {"A": base, "B": base + dim + 1, "AB": base[:, None] + np.arange(1, dim + 1, dtype=np.int64)}
+
+
 def unit_samples(method: str, n: int, dim: int, seed: int) -> NDArray[np.float64]:
-    """``(n, dim)`` points in the open unit hypercube."""
-    if method == "sobol":
+    """``(n, dim)`` points in the open unit hypercube (``n`` designs: for ``"saltelli"`` a
+    multiple of ``dim + 2``, see :func:`design_count`)."""
+    if method == "saltelli":
+        from SALib.sample import sobol as saltelli
+
+        problem = {"num_vars": dim, "names": [f"x{i}" for i in range(dim)], "bounds": [[0.0, 1.0]] * dim}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # a base size that is not a power of two
+            u = saltelli.sample(problem, n // (dim + 2), calc_second_order=False, scramble=True, seed=seed)
+    elif method == "sobol":
         from scipy.stats import qmc
 
         with warnings.catch_warnings():

@@ -15,8 +15,8 @@
     values = { start = 1e4, stop = 1e6, num = 60, scale = "log" }
 
     [sampling]                          # optional
-    method = "grid"                     # "grid" | "random" | "sobol"
-    # n = 10000; seed = 1               # random / sobol
+    method = "grid"                     # "grid" | "random" | "sobol" | "saltelli"
+    # n = 10000; seed = 1               # random / sobol (saltelli: n base samples)
 
     [execution]                         # optional
     chunk_size = 1024                   # designs per chunk (the unit of work and of resuming)
@@ -26,6 +26,10 @@ With ``random`` or ``sobol`` sampling each parameter is drawn from ``values`` (a
 from a ``distribution`` table: ``{kind = "normal", mean, std}``, ``{kind = "lognormal", median,
 sigma}``, ``{kind = "truncnormal", mean, std, low, high}``, ``{kind = "uniform" | "loguniform",
 low, high}``.
+
+``saltelli`` sampling draws Saltelli's cross-sampled design for Sobol sensitivity indices
+(:func:`impstab.studies.sampling.unit_samples`): ``n`` base samples give ``n * (d + 2)``
+designs for ``d`` parameters, from the same distributions.
 """
 
 from __future__ import annotations
@@ -87,7 +91,7 @@ class ParameterSpec(_Strict):
 
 
 class SamplingSpec(_Strict):
-    method: Literal["grid", "random", "sobol"] = "grid"
+    method: Literal["grid", "random", "sobol", "saltelli"] = "grid"
     n: Optional[Annotated[int, Field(ge=1, le=100_000_000)]] = None
     seed: Annotated[int, Field(ge=0)] = 0
 

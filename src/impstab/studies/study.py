@@ -22,8 +22,10 @@ from pydantic import ValidationError
 
 from ..errors import ModelError
 from ..model.assemble import format_location, model_from_dict, read_toml
+from ..model.schema_doc import clean_loc, unknown_key_rule
 from .paths import ParameterPath, resolve_path
 from .sampling import axis_values, check_distribution, map_samples, unit_samples
+from .reference import DOC_PATH as STUDY_DOC_PATH
 from .schema import ParameterSpec, RangeSpec, StudyFile
 
 __all__ = ["Study", "Parameter", "load_study", "study_from_dict", "describe", "MAX_DESIGNS"]
@@ -46,6 +48,11 @@ class Parameter:
 
     path: ParameterPath
     values: NDArray
+
+    def __repr__(self) -> str:
+        from ..display import parameter_text
+
+        return parameter_text(self)
 
     @property
     def name(self) -> str:
@@ -71,6 +78,11 @@ class Study:
     model_source: str | None = None
     seed: int = 0
 
+    def __repr__(self) -> str:
+        from ..display import study_definition_text
+
+        return study_definition_text(self)
+
     @property
     def dims(self) -> tuple[str, ...]:
         """Dimensions of the results: one per parameter for a grid, else ``("sample",)``."""
@@ -94,14 +106,17 @@ def _shown(value: Any) -> Any:
 
 
 def _schema_error(err: ValidationError) -> ModelError:
-    first = err.errors()[0]
-    loc = tuple(p for p in first["loc"] if not (isinstance(p, str) and ("[" in p or p.startswith("function-"))))
+    errors = err.errors()
+    # an unknown key is a typo: report it first (pydantic lists the key it hides as missing first)
+    first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
+    loc = clean_loc(StudyFile, tuple(first["loc"]))
     field = format_location(loc)
     kind = first["type"]
     if kind == "extra_forbidden":
-        return ModelError(field, first.get("input"), "unknown key (check the spelling against the study-file schema)")
+        where = f"in {format_location(loc[:-1])}" if len(loc) > 1 else "at the top level"
+        return ModelError(field, first.get("input"), unknown_key_rule(StudyFile, loc, where, STUDY_DOC_PATH))
     if kind == "missing":
-        return ModelError(field, None, "is required")
+        return ModelError(field, None, f"is required (see {STUDY_DOC_PATH})")
     msg = first["msg"].replace("Value error, ", "").replace("Input should be", "must be")
     return ModelError(field, first.get("input"), msg[0].lower() + msg[1:])
 
@@ -216,7 +231,9 @@ def study_from_dict(
     else:
         if doc.sampling.n is None:
             raise ModelError("sampling.n", None, f"is required with sampling.method = {method!r} (the number of samples)")
-        size = doc.sampling.n
+        from .sampling import design_count  # n base samples of a Saltelli design are n * (d + 2) designs
+
+        size = design_count(method, doc.sampling.n, len(paths))
     if size > MAX_DESIGNS:
         raise ModelError("parameters", f"{size} designs", f"more than {MAX_DESIGNS} designs in one study")
     if method != "grid":

@@ -83,6 +83,16 @@ class BatchCriticalThrust:
     message: list[str]
     evaluations: int = 0
 
+    def __repr__(self) -> str:
+        from ...display import batch_text
+
+        return batch_text(self)
+
+    def _repr_html_(self) -> str:
+        from ...display import batch_html
+
+        return batch_html(self)
+
     @property
     def frequency_hz(self) -> Array:
         """Onset frequency ``omega / 2 pi`` (Hz)."""

@@ -1,0 +1,190 @@
+"""Forced response of a model: transfer functions of a unit load, and the model's excitation.
+
+Both run the same linearization as the stability analysis (:func:`impstab.linearize`: static
+equilibrium or classical, follower and preload stiffness, gyroscopics with the speed law, mount
+dampers) and one stacked solve over all frequencies (:func:`impstab.response.core.harmonic_response`),
+with compressible fluid coefficients at every frequency (:mod:`impstab.response.fluid`) and the
+hull given by the model's ``[foundation]`` (rigid by default).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import ModelError
+from ..linear.linearize import linearize
+from ..linear.modes import modes
+from ..model.foundation import Foundation
+from ..model.model import DOF_NAMES, Model
+from .core import harmonic_response
+from .excitation import excitation_lines, shaft_rate, unit_load
+from .fluid import fluid_dynamic_stiffness, fluid_spectrum
+from .result import ForcedResponse
+
+__all__ = ["frequency_response", "excitation_response", "check_frequencies", "MAX_FREQUENCIES", "default_thrust"]
+
+#: most frequencies in one response (memory: about 1 kB per frequency with four mounts)
+MAX_FREQUENCIES = 100_000
+#: pivot ratio below which a frequency is reported as (nearly) singular
+SINGULAR_PIVOT = 1e-12
+
+
+def check_frequencies(frequencies: ArrayLike, field: str = "frequencies") -> NDArray[np.float64]:
+    """Frequencies (Hz) as a 1-D float array, or a ModelError naming ``field``."""
+    try:
+        f = np.asarray(frequencies, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(field, frequencies, "must be a list of numbers (Hz)") from None
+    f = np.atleast_1d(f)
+    if f.ndim != 1:
+        raise ModelError(field, f.shape, "must be a 1-D list of frequencies (Hz)")
+    if f.size == 0 or f.size > MAX_FREQUENCIES:
+        raise ModelError(field, f"{f.size} frequencies", f"must hold 1 to {MAX_FREQUENCIES} frequencies")
+    bad = np.flatnonzero(~np.isfinite(f) | (f < 0))
+    if bad.size:
+        raise ModelError(field, float(f[bad[0]]), "frequencies must be finite and >= 0 (Hz)")
+    return f + 0.0
+
+
+def default_thrust(model: Model, thrust: float | None) -> float:
+    """The thrust of a response: the given one, else the operating thrust, else 0 (N)."""
+    if thrust is None:
+        return float(model.thrust.operating or 0.0)
+    t = float(thrust)
+    if not np.isfinite(t) or t < 0:
+        raise ModelError("thrust", thrust, "must be a finite number >= 0 (N)")
+    return t
+
+
+def _hull_stiffness(model: Model, foundation, f: NDArray) -> tuple[NDArray | None, str]:
+    """``S (1, nf, nm)`` of the hull at each attachment (None: rigid) and a description."""
+    nm = len(model.mounts)
+    found = model.foundation if foundation is None else foundation
+    per_mount = list(found) if isinstance(found, Sequence) else [found] * nm
+    if len(per_mount) != nm:
+        raise ModelError("foundation", f"{len(per_mount)} entries", f"needs one foundation per mount ({nm})")
+    for i, fd in enumerate(per_mount):
+        if not isinstance(fd, Foundation):
+            raise ModelError(f"foundation[{i}]", type(fd).__name__, "must be an impstab.model.foundation.Foundation")
+    if all(fd.rigid for fd in per_mount):
+        return None, "rigid"
+    s = np.stack([fd.dynamic_stiffness(f) for fd in per_mount], axis=-1)[None]
+    kinds = sorted({fd.model for fd in per_mount})
+    return s, "compliant (" + ", ".join(kinds) + "): isotropic point impedance per attachment, uncoupled"
+
+
+def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearization: str | None, foundation,
+             input_name: str, source: tuple[str, ...]) -> ForcedResponse:
+    lin = linearize(model, thrust, linearization)
+    settings: dict = {"model": model.name, "model_source": model.source or ""}
+    fluid_extra = None
+    spectrum = fluid_spectrum(model, f)
+    if spectrum is not None:
+        fluid_extra, _, _ = fluid_dynamic_stiffness(model, spectrum, lin.rotation)
+        fluid_extra = fluid_extra[None]
+        settings["fluid"] = (
+            f"compressible baffled cylinder at every frequency ({spectrum.method}, {spectrum.evaluations} "
+            f"evaluations, interpolation error <= {spectrum.interpolation_error:.1e}, "
+            f"quadrature error <= {spectrum.quadrature_error:.1e}, relative)"
+        )
+    else:
+        settings["fluid"] = model.fluid.model if model.fluid.model == "none" else f"{model.fluid.model} (frequency independent)"
+    hull, hull_text = _hull_stiffness(model, foundation, f)
+    settings["foundation"] = hull_text
+    pos = np.array([m.position for m in model.mounts], dtype=float)[None]
+    km = np.array([m.stiffness for m in model.mounts], dtype=float)[None]
+    cm = np.array([m.damping for m in model.mounts], dtype=float)[None]
+    sol = harmonic_response(
+        lin.M[None], lin.D[None], lin.G[None], lin.K[None], lin.rotation[None], pos, km, cm,
+        2.0 * np.pi * f, loads[None], fluid=fluid_extra, foundation=hull,
+        fluid_damping=np.zeros((1, 6, 6)),  # linearize takes the fluid at 0 Hz: no radiation damping in lin.D
+    )
+    md = modes(model, thrust, linearization)
+    warnings: list[str] = []
+    if not md.stable:
+        j = int(np.argmax(md.growth_rate))
+        warnings.append(
+            f"the linearized system is unstable at T = {thrust:g} N (growth rate {md.growth_rate[j]:.4g} 1/s at "
+            f"{md.frequency_hz[j]:.4g} Hz): no steady forced response exists; the values are the formal transfer function"
+        )
+    sing = np.flatnonzero(sol.pivot_ratio[0] < SINGULAR_PIVOT)
+    if sing.size:
+        warnings.append(
+            f"the dynamic stiffness is singular or nearly so at {sing.size} frequencies (first {f[sing[0]]:.6g} Hz, "
+            "an undamped resonance): the response there is unbounded or inaccurate"
+        )
+    from .. import __version__
+
+    settings["impstab_version"] = __version__
+    return ForcedResponse(
+        frequency_hz=f, load=np.broadcast_to(loads, (f.size, 6)).copy(), response=sol.response[0],
+        mount_deflection=sol.deflection[0], hull_displacement=sol.hull_displacement[0], mount_force=sol.mount_force[0],
+        hull_force=sol.hull_force[0], power_input=sol.power_input[0], power_thrust=sol.power_thrust[0],
+        power_fluid=sol.power_fluid[0], power_damper=sol.power_damper[0], power_transmitted=sol.power_transmitted[0],
+        pivot_ratio=sol.pivot_ratio[0], thrust=float(thrust), linearization=lin.linearization, input=input_name,
+        shaft_rate=shaft_rate(model, thrust), source=source, mode_frequency_hz=md.frequency_hz,
+        mode_growth_rate=md.growth_rate, mode_dominant=tuple("/".join(d) for d in md.dominant()), settings=settings, warnings=tuple(warnings),
+    )
+
+
+def frequency_response(
+    model: Model,
+    frequencies: ArrayLike,
+    *,
+    thrust: float | None = None,
+    input: str | None = None,
+    linearization: str | None = None,
+    foundation: Foundation | Sequence[Foundation] | None = None,
+) -> ForcedResponse:
+    """Response to a unit harmonic force or moment at A on one dof, at each frequency.
+
+    Parameters
+    ----------
+    model : Model
+    frequencies : array_like
+        Frequencies (Hz), finite and >= 0, at most :data:`MAX_FREQUENCIES`.
+    thrust : float, optional
+        Thrust of the linearization (N); default the operating thrust, else 0.
+    input : str, optional
+        Dof of the unit load (hull axes, at A): a force (N) on surge/sway/heave, a moment (N m)
+        on roll/pitch/yaw. Default ``model.excitation.input`` (sway unless the model says).
+    linearization : {"equilibrium", "classical"}, optional
+        Override the model's setting.
+    foundation : Foundation or sequence of Foundation, optional
+        The hull at the attachments (one for all mounts, or one per mount); default the model's.
+
+    Returns
+    -------
+    ForcedResponse
+        ``.transmissibility`` is ``|F_hull| / |F_in|`` (N/N; N/(N m) for a moment input).
+    """
+    f = check_frequencies(frequencies)
+    t = default_thrust(model, thrust)
+    dof = model.excitation.input if input is None else input
+    if dof not in DOF_NAMES:
+        raise ModelError("input", dof, f"must be one of {list(DOF_NAMES)}")
+    return _respond(model, f, unit_load(dof)[None, :], t, linearization, foundation, dof, ())
+
+
+def excitation_response(
+    model: Model,
+    *,
+    thrust: float | None = None,
+    linearization: str | None = None,
+    foundation: Foundation | Sequence[Foundation] | None = None,
+) -> ForcedResponse:
+    """Response to the model's ``[excitation]`` (unbalance, blade rate, spectrum lines) at a thrust.
+
+    One entry per line (``.source`` names its key), sorted as the lines are listed; ``.bands()``
+    gives the one-third-octave levels of the hull force. Parameters as :func:`frequency_response`.
+    """
+    t = default_thrust(model, thrust)
+    if not model.excitation.has_loads:
+        raise ModelError("excitation", None, "the model has no [excitation] loads (unbalance, blade_rate or spectrum)")
+    lin = linearize(model, t, linearization)
+    lines = excitation_lines(model, t, lin.rotation)
+    f = check_frequencies(lines.frequency_hz, "excitation")
+    return _respond(model, f, lines.load, t, linearization, foundation, "excitation", lines.source)
