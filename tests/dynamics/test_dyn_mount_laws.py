@@ -397,3 +397,19 @@ def test_study_paths_reach_the_laws(tmp_path):
             assert got == pytest.approx(ref, rel=1e-10), (k3, ks)
     t = ds["critical_thrust"].values
     assert t[0, 1] < t[1, 1] < t[2, 1]  # hardening raises T_c here, softening lowers it
+
+
+def test_static_mount_loads_with_laws_balance_the_thrust():
+    """The static load of each mount on the hull includes its law: at the equilibrium the mount
+    forces carry the thrust."""
+    from impstab.response import static_mount_loads
+
+    model = model_from_dict(nonlinear_asymmetric())
+    t = 4500.0
+    loads = static_mount_loads(model, t, "equilibrium")
+    lin = impstab.linearize(model, t)
+    f_t = t * (lin.rotation @ model.thrust.direction)
+    np.testing.assert_allclose(loads.force.sum(axis=0), f_t, rtol=1e-9, atol=1e-9 * t)
+    # without the law the springs alone would not balance it (the snubber carries a good part)
+    spring = loads.force[0] - np.array(law_gradient(table(model.mounts[0].nonlinear), 0, *loads.deflection[0]))
+    assert np.linalg.norm(spring - loads.force[0]) > 0.05 * np.linalg.norm(loads.force[0])
