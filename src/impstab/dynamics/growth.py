@@ -220,36 +220,6 @@ def modal_fit(y: Array, dt: float, sv_tol: float = 1e-7) -> ModalFit | None:
     return ModalFit(np.log(mu) / dt, start, contribution, misfit, order)
 
 
-def envelope_peaks(t: Array, x: Array) -> tuple[Array, Array]:
-    """Times (s) and values of the local maxima of ``|x|``, refined by a parabola in ``x``."""
-    t = np.asarray(t, dtype=float)
-    x = np.asarray(x, dtype=float)
-    if x.size < 3:
-        return np.empty(0), np.empty(0)
-    a = np.abs(x)
-    i = np.nonzero((a[1:-1] >= a[:-2]) & (a[1:-1] > a[2:]))[0] + 1
-    xm, x0, xp = x[i - 1], x[i], x[i + 1]
-    curv = xp - 2.0 * x0 + xm
-    with np.errstate(divide="ignore", invalid="ignore"):
-        shift = np.where(curv != 0, 0.5 * (xm - xp) / curv, 0.0)
-    shift = np.clip(shift, -1.0, 1.0)
-    peak = np.abs(x0 - 0.25 * (xm - xp) * shift)
-    dt = np.where(shift >= 0, t[np.minimum(i + 1, t.size - 1)] - t[i], t[i] - t[i - 1])
-    return t[i] + shift * dt, peak
-
-
-def _extremum(x: Array, sign: float) -> float:
-    """Largest (``sign = 1``) or smallest (``-1``) value of the samples ``x``, refined by a
-    parabola through the extreme sample and its neighbours."""
-    i = int(np.argmax(sign * x))
-    if 0 < i < x.size - 1:
-        xm, x0, xp = x[i - 1], x[i], x[i + 1]
-        curv = xp - 2.0 * x0 + xm
-        if curv * sign < 0:
-            return float(x0 - 0.125 * (xp - xm) ** 2 / curv)
-    return float(x[i])
-
-
 def _refined_extrema(t: Array, x: Array, sign: float) -> tuple[Array, Array]:
     """Times and values of the local maxima (``sign = 1``) or minima (``-1``) of the samples
     ``x``, each refined by the parabola through it and its neighbours."""
@@ -261,6 +231,19 @@ def _refined_extrema(t: Array, x: Array, sign: float) -> tuple[Array, Array]:
         shift = np.clip(np.where(curv < 0, 0.5 * (ym - yp) / curv, 0.0), -1.0, 1.0)
         peak = np.where(curv < 0, y0 - 0.125 * (yp - ym) ** 2 / curv, y0)
     return t[i] + shift * (t[i + 1] - t[i]), sign * peak
+
+
+def envelope_peaks(t: Array, x: Array) -> tuple[Array, Array]:
+    """Times (s) and values of the local maxima of ``|x|``, refined by a parabola."""
+    return _refined_extrema(np.asarray(t, dtype=float), np.abs(np.asarray(x, dtype=float)), 1.0)
+
+
+def _half_range(t: Array, x: Array) -> float:
+    """Half the peak-to-peak of ``x`` over the samples, extremes refined by a parabola (the
+    sampled extreme where it lies at an end)."""
+    hi = _refined_extrema(t, x, 1.0)[1]
+    lo = _refined_extrema(t, x, -1.0)[1]
+    return 0.5 * (max(hi.max(initial=-np.inf), x.max()) - min(lo.min(initial=np.inf), x.min()))
 
 
 def _upward_crossings(t: Array, x: Array) -> Array:
@@ -305,8 +288,7 @@ def _tail_cycle(t: Array, disp: Array, j: int) -> _Cycle | None:
     change = float(np.max(np.abs(amps[-m:] - last_a)) / last_a) if last_a > 0 else math.inf
     settled = bool(np.max(np.abs(periods[-m:] - last_p)) <= CYCLE_RTOL * last_p and change <= CYCLE_RTOL)
     sel = (tt >= cross[-2]) & (tt <= cross[-1])
-    amplitude = {name: 0.5 * (_extremum(xx[sel, d], 1.0) - _extremum(xx[sel, d], -1.0))
-                 for d, name in enumerate(DOF_NAMES)}
+    amplitude = {name: _half_range(tt[sel], xx[sel, d]) for d, name in enumerate(DOF_NAMES)}
     return _Cycle(settled, float(last_p), amplitude, change, m)
 
 
