@@ -40,7 +40,8 @@ class SimulationResult:
     completed : bool
         False when the run stopped early; ``stop_reason`` and ``stop_time`` (s) say why and when.
     growth : GrowthFit
-        Envelope growth rate fitted from the run and ``max Re(lambda)`` at the same thrust.
+        What the run shows: envelope label, fitted growth rate beside ``max Re(lambda)`` at the
+        same thrust, a limit cycle's period and amplitudes, or why it is undetermined.
     classification : {"subcritical", "critical", "supercritical", "unknown", "not computed"}
     """
 
