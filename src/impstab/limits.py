@@ -144,6 +144,8 @@ RANGES: dict[str, Range] = {
     "direction": Range(-1e6, 1e6, "", "a direction component"),
     "angle": Range(-360.0, 360.0, "deg", "an angle in degrees"),
     "stiffness": Range(0.0, 1e13, "N/m", "a mount stiffness"),
+    "cubic_stiffness": Range(-1e20, 1e20, "N/m^3", "a cubic mount stiffness"),
+    "clearance": Range(0.0, 10.0, "m", "a snubber clearance"),
     "stiffness_entry": Range(-1e13, 1e13, "N/m, N or N m/rad", "a 6x6 stiffness entry"),
     "damping": Range(0.0, 1e11, "N s/m", "a mount damping"),
     "damping_entry": Range(-1e11, 1e11, "N s/m, N s or N m s/rad", "a 6x6 damping entry"),

@@ -176,3 +176,71 @@ def test_pitch_guard_in_the_right_hand_side():
 def test_skew_convention_used_by_the_oracles():
     a, b = np.array([1.0, 2.0, 3.0]), np.array([-0.5, 0.3, 2.0])
     np.testing.assert_allclose(skew(a) @ b, np.cross(a, b))
+
+
+def nonlinear_case():
+    """The asymmetric layout with cubic springs and a snubber engaged at 4500 N."""
+    d = asymmetric(damped=True, gyro=True, tangency=0.8)
+    for i, m in enumerate(d["mounts"][:3]):
+        m["k3_axial"] = [2e8, -1e8, 1e8][i]
+        m["k3_shear"] = [5e8, 2e8, -1e8][i]
+    d["mounts"][0].update(snubber_clearance=0.004, snubber_stiffness=3e6)
+    return d, 4500.0
+
+
+COMPLEX_CASES = {**CASES, "nonlinear-laws": nonlinear_case()}
+
+
+@pytest.mark.parametrize("case", sorted(COMPLEX_CASES))
+def test_complex_step_jacobian_equals_the_state_matrix(case):
+    """The compiled right-hand side on complex states: its complex-step Jacobian at the static
+    equilibrium, mapped to q = (du, dphi), is the exact tangent to rounding."""
+    from impstab.dynamics.system import NonlinearSystem
+
+    d, thrust = COMPLEX_CASES[case]
+    model = model_from_dict(d)
+    ns = NonlinearSystem(model)
+    y0 = ns.equilibrium(thrust)
+    lin = linearize(model, thrust, "equilibrium")
+    jac = ns.jacobian(y0, thrust)
+    p = linear_coordinates_map(y0, lin.rotation)
+    a = lin.state_matrix()
+    mapped = p @ jac @ np.linalg.inv(p)
+    # measured 6e-16 to 3e-13 (the stiff engaged snubber); central differences give 5e-11
+    assert np.abs(mapped - a).max() < 5e-13 * np.abs(a).max(), np.abs(mapped - a).max() / np.abs(a).max()
+    # the real part of a complex evaluation is the real evaluation, to rounding
+    rng = np.random.default_rng(7)
+    ys = y0 + rng.normal(scale=1e-3, size=(5, 12))
+    real = ns.rhs(ys, thrust)
+    cplx = ns.rhs(ys + 1e-40j * rng.normal(size=(5, 12)), thrust)
+    assert cplx.dtype == complex and real.dtype == float and real.shape == (5, 12)
+    assert np.abs(cplx.real - real).max() <= 1e-15 * np.abs(real).max()
+    # one implementation: the batch entry equals the integrators' entry point
+    for y in ys[:2]:
+        np.testing.assert_array_equal(ns.rhs(y, thrust), evaluate_rhs(ns.system, np.zeros(12), y, thrust,
+                                                                       ns.spin(thrust))[0])
+
+
+def test_cauchy_taylor_coefficients_of_the_complex_rhs_are_exact():
+    """Second and third derivatives along a direction from evaluations on a complex circle
+    (f(y0 + r e^{i theta} v), FFT) equal finite differences of the complex-step Jacobian and of
+    the second coefficient; the circle is far from the snubber's contact radius."""
+    from impstab.dynamics.system import NonlinearSystem
+
+    d, thrust = nonlinear_case()
+    ns = NonlinearSystem(model_from_dict(d))
+    y0 = ns.equilibrium(thrust)
+    rng = np.random.default_rng(11)
+    v = rng.normal(size=12) * np.array([1e-3] * 3 + [1e-2] * 3 + [1e-2] * 6)
+    k, r = 32, 0.5
+    theta = 2 * np.pi * np.arange(k) / k
+    f = ns.rhs(y0[None, :] + r * np.exp(1j * theta)[:, None] * v[None, :], thrust)
+    coef = np.fft.fft(f, axis=0) / k / r ** np.arange(k)[:, None]  # c_m = D^m f [v]^m / m!
+    jv = ns.jacobian(y0, thrust) @ v
+    np.testing.assert_allclose(coef[1].real, jv, rtol=1e-10, atol=1e-10 * np.abs(jv).max())
+    h = 1e-4
+    d2 = (ns.jacobian(y0 + h * v, thrust) @ v - ns.jacobian(y0 - h * v, thrust) @ v) / (2 * h)
+    np.testing.assert_allclose(2 * coef[2].real, d2, rtol=1e-6, atol=1e-6 * np.abs(d2).max())
+    d3 = (ns.jacobian(y0 + h * v, thrust) @ v - 2 * jv + ns.jacobian(y0 - h * v, thrust) @ v) / h**2
+    np.testing.assert_allclose(6 * coef[3].real, d3, rtol=1e-4, atol=1e-4 * np.abs(d3).max())
+    assert np.abs(coef[:5].imag).max() <= 1e-9 * np.abs(coef[:5]).max()  # a real function on the real axis

@@ -19,7 +19,7 @@ from impstab.model import model_from_dict
 
 
 def forces(pk, thrust, u, rot):
-    return pose_forces(u, rot, thrust, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency)[0]
+    return pose_forces(u, rot, thrust, pk.positions, pk.stiffness, pk.damping, pk.e_dir, pk.r_thrust, pk.tangency, pk.laws)[0]
 
 
 def fd_jacobian(pk, thrust, u0, r0, h=1e-6):
@@ -62,7 +62,7 @@ def test_preload_switch_drops_only_mount_preload_term():
     on_lin, off_lin = linearize(model, t), linearize(off, t)
     pk = pack_model(model)
     _, _, k_pre, _, _ = pose_forces(on_lin.displacement, on_lin.rotation, t, pk.positions, pk.stiffness,
-                                    pk.damping, pk.e_dir, pk.r_thrust, pk.tangency)
+                                    pk.damping, pk.e_dir, pk.r_thrust, pk.tangency, pk.laws)
     assert np.allclose(on_lin.K - off_lin.K, k_pre, rtol=1e-12, atol=1e-9)
     assert np.abs(k_pre[:3]).max() == 0 and np.abs(k_pre[:, :3]).max() == 0
 
@@ -134,3 +134,44 @@ def test_mass_and_gyroscopic_matrices_at_the_deflected_pose():
     h = 0.05 * spin * lin.rotation @ model.thrust.direction
     assert np.allclose(lin.G[3:, 3:], -skew(h), rtol=1e-13, atol=1e-12)
     assert np.allclose(lin.G, -lin.G.T)
+
+
+def test_soft_shear_mounts_keep_the_straight_equilibrium_and_the_commands_agree(capsys, tmp_path, examples):
+    """A shear stiffness of 1 N/m under 8 kN: rounding alone moves the pose by more than the old
+    fixed Newton tolerance, and `modes` lost the exact straight equilibrium that `critical` and
+    `locus` (affine, no Newton) use. Now the Newton path at every thrust equals the affine
+    matrices, and `modes`, `critical` and `locus` agree on where the model turns unstable."""
+    import json
+
+    from impstab import critical_thrust, locus, modes
+    from impstab.cli import main
+    from impstab.linear.linearize import ModelFamily
+
+    d = ring_model_dict()
+    d["mount_rings"][0]["k_shear"] = 1.0
+    model = model_from_dict(d)
+    fam = ModelFamily(model)
+    assert fam.is_affine
+    thrusts = np.linspace(0.0, 20000.0, 81)
+    m, dd, g, k, u0, r0 = fam.evaluate(thrusts)  # Newton continuation at every thrust
+    _, _, _, k_affine = fam.matrices(thrusts)
+    assert np.abs(k - k_affine).max() <= 1e-9 * np.abs(k_affine).max()
+    np.testing.assert_allclose(r0, np.broadcast_to(np.eye(3), r0.shape), atol=1e-12)
+    np.testing.assert_allclose(u0[:, 0], thrusts / 3e5, rtol=1e-12)
+    crit = critical_thrust(model)
+    assert crit.kind == "flutter"
+    loc = locus(model, thrusts)
+    unstable_locus = loc.growth_rate.max(axis=1) > 1e-9
+    unstable_modes = np.array([modes(model, t).growth_rate.max() > 1e-9 for t in thrusts])
+    np.testing.assert_array_equal(unstable_locus, unstable_modes)
+    np.testing.assert_array_equal(unstable_modes, thrusts > crit.thrust)
+    # and on the command line: modes at 8 kN has an equilibrium and is stable
+    text = (examples / "imp_symmetric.toml").read_text()
+    assert "k_shear = 2.0e4" in text
+    path = tmp_path / "soft.toml"
+    path.write_text(text.replace("k_shear = 2.0e4", "k_shear = 1.0"))
+    assert main(["modes", str(path), "--thrust", "8000"]) == 0
+    out = capsys.readouterr().out
+    assert "stable" in out and "UNSTABLE" not in out
+    assert main(["critical", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["critical_thrust"] == pytest.approx(crit.thrust, rel=1e-12)

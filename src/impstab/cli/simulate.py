@@ -118,7 +118,7 @@ def _table(results, model_name: str):
             fmt(r.thrust[0]), r.classification, g.envelope if g else "no fit",
             fmt(g.rate, digits=5) if exponential else "n/a",
             growth(g.linear_rate, r.fastest_omega) if g and g.linear_rate is not None else "not computed",
-            f"{100 * diff:.2f} %" if diff is not None and exponential else "n/a",
+            fmt(100 * diff, "%", digits=2) if diff is not None and exponential else "n/a",
             "completed" if r.completed else "[red]stopped[/red]",
         )
     return t
@@ -129,6 +129,14 @@ def _notes(results) -> list[str]:
     steps = ", ".join(str(r.steps) if r.steps >= 0 else f"{r.rhs_evaluations} f-evals" for r in results)
     lines.append(f"steps: {steps}; run time: {', '.join(fmt(r.wall_time, digits=3) for r in results)} s")
     lines += [f"T = {r.thrust[0]:.6g} N: {user_text(r.stop_reason)}" for r in results if not r.completed]
+    for r in results:
+        g = r.growth
+        if g is not None and g.envelope == "limit cycle" and g.amplitude:
+            amps = ", ".join(f"{k} {fmt(v, digits=4)} {'m' if k in ('surge', 'sway', 'heave') else 'rad'}"
+                             for k, v in g.amplitude.items())
+            lines.append(f"T = {r.thrust[0]:.6g} N: limit cycle, period {fmt(g.period, digits=6)} s, amplitude {amps}")
+        if g is not None and g.reason:
+            lines.append(f"T = {r.thrust[0]:.6g} N: {g.envelope}: {g.reason}")
     return lines
 
 

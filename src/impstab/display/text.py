@@ -54,6 +54,12 @@ def mount_text(mt) -> str:
         text += f", {_vec(k[3:])} N m/rad"
     if np.any(mt.damping):
         text += f", damping diagonal {_vec(np.diag(mt.damping)[:3])} N s/m"
+    law = getattr(mt, "nonlinear", None)
+    if law is not None and not law.is_linear:
+        if law.k3_axial or law.k3_shear:
+            text += f", k3 axial {number(law.k3_axial)}, shear {number(law.k3_shear)} N/m^3"
+        if law.has_snubber:
+            text += f", snubber {number(law.snubber_clearance)} m, {number(law.snubber_stiffness)} N/m"
     return text + ")"
 
 

@@ -33,7 +33,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .rhs import AMPLITUDE, DOUBLE, HALVE, NONFINITE, OK, PITCH, rhs_into
+from .rhs import AMPLITUDE, DOUBLE, HALVE, KIND_LINEAR, KIND_MODEL, NONFINITE, OK, PITCH, linear_rhs, model_rhs, workspace
 
 __all__ = ["run_fixed", "METHOD_GILL", "METHOD_HAMMING", "CARRY_ROWS"]
 
@@ -52,51 +52,7 @@ HAM_MOD = 112.0 / 121.0
 HAM_FIN = 9.0 / 121.0
 
 
-@njit(cache=True, inline="always")
-def _gill_step(kind, arrays, yeq, h, z, fz, th, sh, te, se, znew, work):
-    """One step of Gill's method from ``z`` (derivative ``fz`` known) into ``znew``."""
-    n = z.shape[0]
-    k1, k2, k3, k4, tmp = work[0], work[1], work[2], work[3], work[4]
-    for i in range(n):
-        k1[i] = h * fz[i]
-        tmp[i] = z[i] + 0.5 * k1[i]
-    st = rhs_into(kind, arrays, yeq, tmp, th, sh, k2)
-    for i in range(n):
-        k2[i] = h * k2[i]
-        tmp[i] = z[i] + GILL_A * k1[i] + GILL_B * k2[i]
-    st = max(st, rhs_into(kind, arrays, yeq, tmp, th, sh, k3))
-    for i in range(n):
-        k3[i] = h * k3[i]
-        tmp[i] = z[i] + GILL_C * k2[i] + GILL_D * k3[i]
-    st = max(st, rhs_into(kind, arrays, yeq, tmp, te, se, k4))
-    for i in range(n):
-        k4[i] = h * k4[i]
-        znew[i] = z[i] + (k1[i] + GILL_W2 * k2[i] + GILL_W3 * k3[i] + k4[i]) / 6.0
-    return st
-
-
-@njit(cache=True, inline="always")
-def _hamming_step(kind, arrays, yeq, h, carry, te, se, znew, work, weights):
-    """One Hamming step from the carried history into ``znew``; returns (status, error, p - c)."""
-    n = znew.shape[0]
-    p, m, fm = work[0], work[1], work[2]
-    for i in range(n):
-        p[i] = carry[3, i] + (4.0 * h / 3.0) * (2.0 * carry[4, i] - carry[5, i] + 2.0 * carry[6, i])
-        m[i] = p[i] - HAM_MOD * carry[7, i]
-    st = rhs_into(kind, arrays, yeq, m, te, se, fm)
-    num = 0.0
-    den = 0.0
-    for i in range(n):
-        c = (9.0 * carry[0, i] - carry[2, i] + 3.0 * h * (fm[i] + 2.0 * carry[4, i] - carry[5, i])) / 8.0
-        znew[i] = c + HAM_FIN * (p[i] - c)
-        p[i] = p[i] - c
-        num = max(num, weights[i] * abs(p[i]))
-        den = max(den, weights[i] * abs(znew[i]))
-    err = HAM_FIN * num / max(den, 1e-300)
-    return st, err
-
-
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _shift(carry, znew, fnew, pc, n):
     for i in range(n):
         carry[3, i] = carry[2, i]
@@ -109,7 +65,7 @@ def _shift(carry, znew, fnew, pc, n):
         carry[7, i] = pc[i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_fixed(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist, out_z, out_err, k0,
               weights, tol, amp_limit, allow_double):
     """Advance ``n_steps`` fixed steps of size ``h`` (s) from the state in ``carry[0]``.
@@ -130,59 +86,140 @@ def run_fixed(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist
     status, steps_done, nhist, samples_written
         On a stop (non-finite state, pitch guard, amplitude) the last accepted state is written as
         one extra sample when it does not fall on the sampling grid.
+
+    All buffers (the Runge-Kutta stages, the predictor, the right-hand side's workspace) are
+    allocated once per call, before the step loop; the loop allocates nothing.
     """
     n = carry.shape[1]
-    work = np.empty((5, n))
-    znew = np.empty(n)
-    fnew = np.empty(n)
-    zero = np.zeros(n)
-    pc = np.empty(n)
+    buffers = np.empty((8, n))
+    rot, jinv, ws = workspace(buffers[0])
+    return _advance(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist, out_z, out_err, k0,
+                    weights, tol, amp_limit, allow_double, buffers[0], buffers[1], buffers[2], buffers[3],
+                    buffers[4], buffers[5], buffers[6], buffers[7], rot, jinv, ws)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _advance(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist, out_z, out_err, k0,
+             weights, tol, amp_limit, allow_double, k1, k2, k3, k4, tmp, znew, fnew, pc, rot, jinv, ws):
+    """The step loop of :func:`run_fixed` on buffers it allocated.
+
+    Compiled without numba's runtime (no reference counting in the loop) and with the
+    right-hand side inlined at its only call site: each step walks through its stages (Gill:
+    three stage evaluations, Hamming: the modifier; then the new state), preparing the stage's
+    state in ``tmp`` and evaluating f there. One call site keeps the compiled code small while
+    the right-hand side is inlined (a call with its ~130 scalar arguments costs a quarter of an
+    evaluation).
+    """
+    n = carry.shape[1]
+    pos, kmat, cmat, flags, laws = arrays[0], arrays[1], arrays[2], arrays[3], arrays[4]
+    par, minv, damp6, amat = arrays[5], arrays[6], arrays[7], arrays[8]
     written = 0
     errmax = -1.0
     quiet = 0
     status = OK
     done = 0
+    stop = False
     for step in range(n_steps):
         j = 2 * step
-        if nhist == 0:
-            st = rhs_into(kind, arrays, yeq, carry[0], loads[0, j], loads[1, j], fnew)
-            if st != OK:
-                status = st
+        gill = method == METHOD_GILL or nhist < 4
+        final = 3 if gill else 1  # the stage that evaluates f at the new state
+        stage = -1 if nhist == 0 else 0  # stage -1: f at the current state after a (re)start
+        acc = OK
+        err = -1.0
+        while True:
+            # the state of this stage into tmp, its load index and the buffer f goes to
+            jl = j + 2
+            dest = fnew
+            if stage == -1:
+                for i in range(n):
+                    tmp[i] = carry[0, i]
+                jl = j
+            elif stage == final:
+                if gill:
+                    for i in range(n):
+                        k4[i] = h * k4[i]
+                        znew[i] = carry[0, i] + (k1[i] + GILL_W2 * k2[i] + GILL_W3 * k3[i] + k4[i]) / 6.0
+                        pc[i] = 0.0
+                else:
+                    # corrector with f at the modifier (in k2), final value, local error
+                    num = 0.0
+                    den = 0.0
+                    for i in range(n):
+                        c = (9.0 * carry[0, i] - carry[2, i] + 3.0 * h * (k2[i] + 2.0 * carry[4, i] - carry[5, i])) / 8.0
+                        znew[i] = c + HAM_FIN * (pc[i] - c)
+                        pc[i] = pc[i] - c
+                        num = max(num, weights[i] * abs(pc[i]))
+                        den = max(den, weights[i] * abs(znew[i]))
+                    err = HAM_FIN * num / max(den, 1e-300)
+                if acc != OK:
+                    status = acc
+                    stop = True
+                    break
+                finite = True
+                for i in range(n):
+                    if not math.isfinite(znew[i]):
+                        finite = False
+                if not finite or not (err < math.inf):
+                    status = NONFINITE
+                    stop = True
+                    break
+                if tol > 0.0 and err > tol:
+                    status = HALVE
+                    stop = True
+                    break
+                for i in range(n):
+                    tmp[i] = znew[i]
+            elif gill:
+                if stage == 0:
+                    for i in range(n):
+                        k1[i] = h * carry[4, i]
+                        tmp[i] = carry[0, i] + 0.5 * k1[i]
+                    jl = j + 1
+                    dest = k2
+                elif stage == 1:
+                    for i in range(n):
+                        k2[i] = h * k2[i]
+                        tmp[i] = carry[0, i] + GILL_A * k1[i] + GILL_B * k2[i]
+                    jl = j + 1
+                    dest = k3
+                else:
+                    for i in range(n):
+                        k3[i] = h * k3[i]
+                        tmp[i] = carry[0, i] + GILL_C * k2[i] + GILL_D * k3[i]
+                    dest = k4
+            else:
+                # Hamming: predictor (into pc) and modifier (into tmp)
+                for i in range(n):
+                    pc[i] = carry[3, i] + (4.0 * h / 3.0) * (2.0 * carry[4, i] - carry[5, i] + 2.0 * carry[6, i])
+                    tmp[i] = pc[i] - HAM_MOD * carry[7, i]
+                dest = k2
+            # the one evaluation of the right-hand side
+            if kind == KIND_LINEAR:
+                st = linear_rhs(amat, tmp, dest)
+            else:
+                st = model_rhs(pos, kmat, cmat, flags, laws, par, minv, damp6, yeq, tmp, loads[0, jl], loads[1, jl],
+                               dest, rot, jinv, ws)
+            if stage == -1:
+                if st != OK:
+                    status = st
+                    stop = True
+                    break
+                for i in range(n):
+                    carry[4, i] = fnew[i]
+                    carry[7, i] = 0.0
+                nhist = 1
+            elif stage == final:
+                if st != OK:
+                    status = st
+                    stop = True
                 break
-            for i in range(n):
-                carry[4, i] = fnew[i]
-                carry[7, i] = 0.0
-            nhist = 1
-        if method == 0 or nhist < 4:
-            st = _gill_step(kind, arrays, yeq, h, carry[0], carry[4], loads[0, j + 1], loads[1, j + 1],
-                            loads[0, j + 2], loads[1, j + 2], znew, work)
-            err = -1.0
-            for i in range(n):
-                pc[i] = zero[i]
-        else:
-            st, err = _hamming_step(kind, arrays, yeq, h, carry, loads[0, j + 2], loads[1, j + 2], znew, work,
-                                    weights)
-            for i in range(n):
-                pc[i] = work[0, i]
-        if st != OK:
-            status = st
-            break
-        finite = True
-        for i in range(n):
-            if not math.isfinite(znew[i]):
-                finite = False
-        if not finite or not (err < math.inf):
-            status = NONFINITE
-            break
-        if tol > 0.0 and err > tol:
-            status = HALVE
-            break
-        st = rhs_into(kind, arrays, yeq, znew, loads[0, j + 2], loads[1, j + 2], fnew)
-        if st != OK:
-            status = st
+            else:
+                acc = max(acc, st)
+            stage += 1
+        if stop:
             break
         amp = 0.0
-        if kind == 0:
+        if kind == KIND_MODEL:
             amp = max(abs(znew[0]), max(abs(znew[1]), abs(znew[2])))
         if amp > amp_limit:
             status = AMPLITUDE

@@ -40,7 +40,8 @@ class SimulationResult:
     completed : bool
         False when the run stopped early; ``stop_reason`` and ``stop_time`` (s) say why and when.
     growth : GrowthFit
-        Envelope growth rate fitted from the run and ``max Re(lambda)`` at the same thrust.
+        What the run shows: envelope label, fitted growth rate beside ``max Re(lambda)`` at the
+        same thrust, a limit cycle's period and amplitudes, or why it is undetermined.
     classification : {"subcritical", "critical", "supercritical", "unknown", "not computed"}
     """
 
@@ -151,8 +152,7 @@ class SimulationResult:
         dev[:, 6:] -= eq[None, 6:]
         loads = np.concatenate([ds["mount_force"].values, ds["mount_moment"].values], axis=2)
         g = json.loads(a.get("growth", "null"))
-        growth = None if g is None else GrowthFit(g["rate"], g["dof"], tuple(g["window"]), g["n_peaks"], g["envelope"],
-                                                  g["linear_rate"], g["thrust"])
+        growth = None if g is None else GrowthFit.from_dict(g)
         kw = {f.name: None for f in fields(cls)}
         kw.update({n: (a[n].item() if hasattr(a[n], "item") else a[n]) for n in _SCALARS if n in a})
         kw.update(time=ds["time"].values, deviation=dev, equilibrium=eq, thrust=ds["thrust"].values, mount_loads=loads,

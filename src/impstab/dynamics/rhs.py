@@ -11,9 +11,11 @@ with ``tau`` (body frame, moment about A) made of
 
 * the mounts: mount i has a 6 x 6 stiffness ``k_i`` and damping ``c_i`` on its body-end deflection
   ``e_i = (X_A + R r_i - r_i, log R)`` (hull frame); the generalized force is the potential and
-  Rayleigh form ``-B_i^T (k_i e_i + c_i e_i')``, ``B_i = [[I, -S(rho_i)], [0, J_l^{-1}]]``,
-  ``rho_i = R r_i``. For the paper's mounts (translation block only) this is
-  ``f_i = -k_i d_i - c_i d_i'`` at the body point;
+  Rayleigh form ``-B_i^T (k_i e_i + c_i e_i' + [grad V_nl(d_i); 0])``,
+  ``B_i = [[I, -S(rho_i)], [0, J_l^{-1}]]``, ``rho_i = R r_i``, where ``V_nl`` is the mount's
+  nonlinear law on the translation deflection ``d_i`` (cubic springs, snubber;
+  :mod:`impstab.model.mount_law`). For the paper's mounts this is
+  ``f_i = -k_i d_i - c_i d_i' - grad V_nl(d_i)`` at the body point;
 * the thrust ``T (eta_t R e + (1 - eta_t) e)`` at ``R r_T`` (follower part, fixed part);
 * the propeller gyroscopic moment ``-nu2 x h``, ``h = J_p Omega e`` (body frame);
 * the fluid radiation damping ``-D_A nu`` (zero for incompressible fluid loading).
@@ -28,6 +30,21 @@ The integrators work on the deviation ``z = y - y_eq`` from the static equilibri
 Everything here is compiled with numba (``cache=True``); with ``NUMBA_DISABLE_JIT=1`` the same
 code runs as plain Python and gives identical results. The code uses scalar loops only (no BLAS
 calls), so that both paths do the same floating-point operations in the same order.
+
+Speed: :func:`model_rhs` allocates nothing and takes no slices; the pose, the rotation and the
+mount deflections live in scalars and in workspace arrays the caller passes in (see
+:func:`workspace`). It is compiled without numba's runtime (``_nrt=False``, numba's own switch
+for code that must not allocate; every helper it uses is inlined into it), so a call touches
+no reference count: with the runtime, numba's reference-count pruning leaves an atomic
+increment and decrement per array argument and call in a function of this shape (about 40 per
+evaluation, measured), which cost more than the arithmetic. Complex states: every operation on the state is analytic (trigonometric functions and
+square roots through :mod:`impstab.kinematics.scalar`, comparisons on real parts only), so the
+same code compiles for complex128 states and complex-step or Cauchy-integral derivatives of it
+are exact. The non-analytic spots are guards only: the pitch guard compares ``Re(theta)``, the
+snubber's contact test compares ``Re(d . d)`` with the squared clearance (``|d| = sqrt(d . d)``
+is analytic away from ``d = 0``, and the snubber never acts near ``d = 0``), the ramp's
+smoothing interval is chosen on the real part, and the clamp of the rotation angle in
+``log R`` (rounding only) acts on the real part.
 """
 
 from __future__ import annotations
@@ -37,37 +54,51 @@ import math
 import numpy as np
 from numba import njit
 
-from ..kinematics.so3 import _jinv, _log_so3
+from ..kinematics.scalar import cos, sin
+from ..kinematics.so3 import _jinv_into, _log_so3_into
+from ..model.mount_law import law_gradient
 
-__all__ = ["rhs_into", "mount_loads_series", "PITCH_LIMIT", "KIND_MODEL", "KIND_LINEAR"]
+__all__ = ["rhs_into", "rhs_batch", "model_rhs", "mount_loads_series", "workspace", "PITCH_LIMIT",
+           "KIND_MODEL", "KIND_LINEAR", "FLAG_ROTATION", "FLAG_LAW"]
 
 #: default guard on the pitch angle (rad): the z-y-x Euler angles are singular at +-90 degrees
 PITCH_LIMIT = math.radians(85.0)
 
-# layout of the scalar parameter vector
-P_MASS, P_CG, P_IA, P_E, P_RT, P_TANG, P_JP, P_PITCH = 0, 1, 4, 13, 16, 19, 20, 21
-N_PAR = 22
+# layout of the scalar parameter vector; P_ROTATION: 1 when a mount has rotational terms,
+# P_RADIATION: 1 when the fluid radiation damping is not zero
+P_MASS, P_CG, P_IA, P_E, P_RT, P_TANG, P_JP, P_PITCH, P_ROTATION, P_RADIATION = 0, 1, 4, 13, 16, 19, 20, 21, 22, 23
+N_PAR = 24
 
 #: status codes of the right-hand side and the steppers
 OK, NONFINITE, PITCH, AMPLITUDE, HALVE, DOUBLE, UNDERFLOW = 0, 1, 2, 3, 4, 5, 6
 
 KIND_MODEL, KIND_LINEAR = 0, 1
 
-#: workspace of the right-hand side: pose (12), mount deflections (12), load (6), tau (6), nu (6)
-WS = 42
+#: per-mount flags: the mount has rotational stiffness or damping (a 6 x 6 mount); it carries a
+#: nonlinear law
+FLAG_ROTATION, FLAG_LAW = 1, 2
+
+#: length of the vector workspace: rotation vector (3), then the deflection and its rate (12)
+WS = 15
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy")
+def workspace(z):
+    """``(rot, jinv, ws)``: the workspace of :func:`model_rhs` for states of ``z``'s dtype."""
+    return np.zeros((3, 3), dtype=z.dtype), np.zeros((3, 3), dtype=z.dtype), np.zeros(WS, dtype=z.dtype)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _cross3(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _euler_into(phi, theta, psi, rot):
     """Rotation body -> hull for z-y-x Euler angles (``J1``); same formula as the linear module."""
-    cf, sf = math.cos(phi), math.sin(phi)
-    ct, st = math.cos(theta), math.sin(theta)
-    cp, sp = math.cos(psi), math.sin(psi)
+    cf, sf = cos(phi), sin(phi)
+    ct, st = cos(theta), sin(theta)
+    cp, sp = cos(psi), sin(psi)
     rot[0, 0] = cp * ct
     rot[0, 1] = -sp * cf + cp * st * sf
     rot[0, 2] = sp * sf + cp * cf * st
@@ -79,127 +110,119 @@ def _euler_into(phi, theta, psi, rot):
     rot[2, 2] = ct * cf
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _rotate(rot, x0, x1, x2):
     return (rot[0, 0] * x0 + rot[0, 1] * x1 + rot[0, 2] * x2,
             rot[1, 0] * x0 + rot[1, 1] * x1 + rot[1, 2] * x2,
             rot[2, 0] * x0 + rot[2, 1] * x1 + rot[2, 2] * x2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _rotate_t(rot, x0, x1, x2):
     return (rot[0, 0] * x0 + rot[1, 0] * x1 + rot[2, 0] * x2,
             rot[0, 1] * x0 + rot[1, 1] * x1 + rot[2, 1] * x2,
             rot[0, 2] * x0 + rot[1, 2] * x1 + rot[2, 2] * x2)
 
 
-@njit(cache=True, inline="always")
-def _mount_load(i, arrays, rot, jinv, ws):
-    """Force (hull frame, N) and mount moment (N m) of mount ``i`` on the body into ``ws[24:30]``
-    (pose in ``ws[0:12]``, see :func:`_pose_into`); returns the arm ``rho_i = R r_i`` (m)."""
-    pos, kmat, cmat, full = arrays[0], arrays[1], arrays[2], arrays[3]
-    x, vh, wh, phi = ws[0:3], ws[3:6], ws[6:9], ws[9:12]
-    e, ed, out = ws[12:18], ws[18:24], ws[24:30]
+@njit(cache=True, inline="always", error_model="numpy")
+def _pose_into(par, yeq, z, rot, jinv, ws):
+    """R into ``rot``; when a mount has rotational terms, ``log R`` into ``ws[0:3]`` and
+    ``J_l^{-1}(log R)`` into ``jinv``."""
+    _euler_into(yeq[3] + z[3], yeq[4] + z[4], yeq[5] + z[5], rot)
+    if par[P_ROTATION] != 0.0:
+        _log_so3_into(rot, ws)
+        _jinv_into(ws, jinv)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _mount_load(i, pos, kmat, cmat, flags, laws, rot, jinv, ws, x0, x1, x2, vh0, vh1, vh2, wh0, wh1, wh2):
+    """Force of mount ``i`` on the body (hull frame, N), its mount moment (N m) and its arm
+    ``rho_i = R r_i`` (m), as nine scalars; the pose is given by its parts."""
     r0, r1, r2 = pos[i, 0], pos[i, 1], pos[i, 2]
     rho0, rho1, rho2 = _rotate(rot, r0, r1, r2)
-    e[0], e[1], e[2] = x[0] + rho0 - r0, x[1] + rho1 - r1, x[2] + rho2 - r2
-    c0, c1, c2 = _cross3(wh[0], wh[1], wh[2], rho0, rho1, rho2)
-    ed[0], ed[1], ed[2] = vh[0] + c0, vh[1] + c1, vh[2] + c2
-    nb = 3
-    if full[i] != 0:
-        nb = 6
+    d0, d1, d2 = x0 + rho0 - r0, x1 + rho1 - r1, x2 + rho2 - r2
+    c0, c1, c2 = _cross3(wh0, wh1, wh2, rho0, rho1, rho2)
+    dd0, dd1, dd2 = vh0 + c0, vh1 + c1, vh2 + c2
+    m0 = m1 = m2 = 0.0 * d0
+    if flags[i] & FLAG_ROTATION:
+        # 6 x 6 mount: e = (d, log R), e' = (d', J_l^{-1} w)
+        ws[3], ws[4], ws[5], ws[6], ws[7], ws[8] = d0, d1, d2, ws[0], ws[1], ws[2]
+        ws[9], ws[10], ws[11] = dd0, dd1, dd2
         for a in range(3):
-            e[3 + a] = phi[a]
-            ed[3 + a] = jinv[a, 0] * wh[0] + jinv[a, 1] * wh[1] + jinv[a, 2] * wh[2]
-    for a in range(6):
-        out[a] = 0.0
-    for a in range(nb):
-        g = 0.0
-        for b in range(nb):
-            g += kmat[i, a, b] * e[b] + cmat[i, a, b] * ed[b]
-        out[a] = -g
-    if nb == 6:
-        g3, g4, g5 = out[3], out[4], out[5]
-        for a in range(3):
-            out[3 + a] = jinv[0, a] * g3 + jinv[1, a] * g4 + jinv[2, a] * g5
-    return rho0, rho1, rho2
+            ws[12 + a] = jinv[a, 0] * wh0 + jinv[a, 1] * wh1 + jinv[a, 2] * wh2
+        g0 = g1 = g2 = g3 = g4 = g5 = 0.0 * d0
+        for b in range(6):
+            eb, edb = ws[3 + b], ws[9 + b]
+            g0 += kmat[i, 0, b] * eb + cmat[i, 0, b] * edb
+            g1 += kmat[i, 1, b] * eb + cmat[i, 1, b] * edb
+            g2 += kmat[i, 2, b] * eb + cmat[i, 2, b] * edb
+            g3 += kmat[i, 3, b] * eb + cmat[i, 3, b] * edb
+            g4 += kmat[i, 4, b] * eb + cmat[i, 4, b] * edb
+            g5 += kmat[i, 5, b] * eb + cmat[i, 5, b] * edb
+        m0 = -(jinv[0, 0] * g3 + jinv[1, 0] * g4 + jinv[2, 0] * g5)
+        m1 = -(jinv[0, 1] * g3 + jinv[1, 1] * g4 + jinv[2, 1] * g5)
+        m2 = -(jinv[0, 2] * g3 + jinv[1, 2] * g4 + jinv[2, 2] * g5)
+    else:
+        g0 = kmat[i, 0, 0] * d0 + cmat[i, 0, 0] * dd0
+        g0 += kmat[i, 0, 1] * d1 + cmat[i, 0, 1] * dd1
+        g0 += kmat[i, 0, 2] * d2 + cmat[i, 0, 2] * dd2
+        g1 = kmat[i, 1, 0] * d0 + cmat[i, 1, 0] * dd0
+        g1 += kmat[i, 1, 1] * d1 + cmat[i, 1, 1] * dd1
+        g1 += kmat[i, 1, 2] * d2 + cmat[i, 1, 2] * dd2
+        g2 = kmat[i, 2, 0] * d0 + cmat[i, 2, 0] * dd0
+        g2 += kmat[i, 2, 1] * d1 + cmat[i, 2, 1] * dd1
+        g2 += kmat[i, 2, 2] * d2 + cmat[i, 2, 2] * dd2
+    if flags[i] & FLAG_LAW:
+        n0, n1, n2 = law_gradient(laws, i, d0, d1, d2)
+        g0 += n0
+        g1 += n1
+        g2 += n2
+    return -g0, -g1, -g2, m0, m1, m2, rho0, rho1, rho2
 
 
-@njit(cache=True, inline="always")
-def _pose_into(arrays, yeq, z, rot, jinv, ws):
-    """Absolute pose: R into ``rot``; position, hull-frame velocities and rotation vector into
-    ``ws[0:12]``; ``J_l^{-1}`` into ``jinv`` (only when a mount has rotational terms)."""
-    for a in range(3):
-        ws[a] = yeq[a] + z[a]
-    _euler_into(yeq[3] + z[3], yeq[4] + z[4], yeq[5] + z[5], rot)
-    ws[3], ws[4], ws[5] = _rotate(rot, yeq[6] + z[6], yeq[7] + z[7], yeq[8] + z[8])
-    ws[6], ws[7], ws[8] = _rotate(rot, yeq[9] + z[9], yeq[10] + z[10], yeq[11] + z[11])
-    full = arrays[3]
-    any_full = False
-    for i in range(full.shape[0]):
-        if full[i] != 0:
-            any_full = True
-    if any_full:
-        phi = _log_so3(rot)
-        jl = _jinv(phi)
-        for a in range(3):
-            ws[9 + a] = phi[a]
-            for b in range(3):
-                jinv[a, b] = jl[a, b]
+@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def model_rhs(pos, kmat, cmat, flags, laws, par, minv, damp6, yeq, z, thrust, spin, out, rot, jinv, ws):
+    """``out = z'`` of the propulsor model at deviation ``z`` (thrust ``thrust`` N, spin
+    ``spin`` rad/s), allocation-free: ``rot``, ``jinv`` and ``ws`` are the workspace of
+    :func:`workspace` (of ``z``'s dtype; real or complex).
 
-
-@njit(cache=True)
-def rhs_into(kind, arrays, yeq, z, thrust, spin, out):
-    """``out = z'`` at deviation ``z`` with thrust ``thrust`` (N) and spin ``spin`` (rad/s).
-
-    Returns a status: 0, or 2 when ``|theta|`` reached the pitch guard (the derivative is still
-    computed unless ``cos(theta)`` vanishes).
+    Returns a status: 0, or 2 when ``|Re theta|`` reached the pitch guard (the derivative is
+    still computed unless ``cos(theta)`` vanishes).
     """
-    if kind == KIND_LINEAR:
-        amat = arrays[7]
-        n = z.shape[0]
-        for i in range(n):
-            s = 0.0
-            for j in range(n):
-                s += amat[i, j] * z[j]
-            out[i] = s
-        return OK
-    par, minv, damp6 = arrays[4], arrays[5], arrays[6]
     theta = yeq[4] + z[4]
-    ct = math.cos(theta)
+    ct = cos(theta)
     status = OK
-    if abs(theta) >= par[P_PITCH]:
+    if abs(theta.real) >= par[P_PITCH]:
         status = PITCH
-        if abs(ct) < 1e-12:
+        if abs(ct.real) < 1e-12:
             for i in range(12):
                 out[i] = math.nan
             return status
-    mats = np.zeros((2, 3, 3))
-    ws = np.zeros(WS)
-    rot, jinv = mats[0], mats[1]
-    _pose_into(arrays, yeq, z, rot, jinv, ws)
-    vh = ws[3:6]
+    _pose_into(par, yeq, z, rot, jinv, ws)
+    x0, x1, x2 = yeq[0] + z[0], yeq[1] + z[1], yeq[2] + z[2]
     u, v, w = yeq[6] + z[6], yeq[7] + z[7], yeq[8] + z[8]
     p, q, r = yeq[9] + z[9], yeq[10] + z[10], yeq[11] + z[11]
+    vh0, vh1, vh2 = _rotate(rot, u, v, w)
+    wh0, wh1, wh2 = _rotate(rot, p, q, r)
     # kinematics: X' = R nu1, Xi' = J2(Xi) nu2
-    out[0], out[1], out[2] = vh[0], vh[1], vh[2]
-    sf, cf = math.sin(yeq[3] + z[3]), math.cos(yeq[3] + z[3])
-    tt = math.sin(theta) / ct
+    out[0], out[1], out[2] = vh0, vh1, vh2
+    sf, cf = sin(yeq[3] + z[3]), cos(yeq[3] + z[3])
+    tt = sin(theta) / ct
     out[3] = p + sf * tt * q + cf * tt * r
     out[4] = cf * q - sf * r
     out[5] = (sf * q + cf * r) / ct
     # forces in the hull frame, moments about A
-    f0 = f1 = f2 = m0 = m1 = m2 = 0.0
-    load = ws[24:30]
-    for i in range(arrays[0].shape[0]):
-        rho0, rho1, rho2 = _mount_load(i, arrays, rot, jinv, ws)
-        c0, c1, c2 = _cross3(rho0, rho1, rho2, load[0], load[1], load[2])
-        f0 += load[0]
-        f1 += load[1]
-        f2 += load[2]
-        m0 += c0 + load[3]
-        m1 += c1 + load[4]
-        m2 += c2 + load[5]
+    f0 = f1 = f2 = m0 = m1 = m2 = 0.0 * x0
+    for i in range(pos.shape[0]):
+        l0, l1, l2, l3, l4, l5, rho0, rho1, rho2 = _mount_load(
+            i, pos, kmat, cmat, flags, laws, rot, jinv, ws, x0, x1, x2, vh0, vh1, vh2, wh0, wh1, wh2)
+        c0, c1, c2 = _cross3(rho0, rho1, rho2, l0, l1, l2)
+        f0 += l0
+        f1 += l1
+        f2 += l2
+        m0 += c0 + l3
+        m1 += c1 + l4
+        m2 += c2 + l5
     e0, e1, e2 = par[P_E], par[P_E + 1], par[P_E + 2]
     tang = par[P_TANG]
     re0, re1, re2 = _rotate(rot, e0, e1, e2)
@@ -214,58 +237,115 @@ def rhs_into(kind, arrays, yeq, z, thrust, spin, out):
     m0 += c0
     m1 += c1
     m2 += c2
-    tau = ws[30:36]
-    tau[0], tau[1], tau[2] = _rotate_t(rot, f0, f1, f2)
-    tau[3], tau[4], tau[5] = _rotate_t(rot, m0, m1, m2)
+    tau0, tau1, tau2 = _rotate_t(rot, f0, f1, f2)
+    tau3, tau4, tau5 = _rotate_t(rot, m0, m1, m2)
     # propeller gyroscopic moment -w x h
     hmag = par[P_JP] * spin
     c0, c1, c2 = _cross3(p, q, r, hmag * e0, hmag * e1, hmag * e2)
-    tau[3] -= c0
-    tau[4] -= c1
-    tau[5] -= c2
+    tau3 -= c0
+    tau4 -= c1
+    tau5 -= c2
     # Coriolis-centripetal terms C_RB(nu) nu (Newton-Euler form)
     mass = par[P_MASS]
     g0, g1, g2 = par[P_CG], par[P_CG + 1], par[P_CG + 2]
     wv0, wv1, wv2 = _cross3(p, q, r, u, v, w)
     wg0, wg1, wg2 = _cross3(p, q, r, g0, g1, g2)
     wwg0, wwg1, wwg2 = _cross3(p, q, r, wg0, wg1, wg2)
-    tau[0] -= mass * (wv0 + wwg0)
-    tau[1] -= mass * (wv1 + wwg1)
-    tau[2] -= mass * (wv2 + wwg2)
-    ia = par[P_IA:P_IA + 9]
-    iw0 = ia[0] * p + ia[1] * q + ia[2] * r
-    iw1 = ia[3] * p + ia[4] * q + ia[5] * r
-    iw2 = ia[6] * p + ia[7] * q + ia[8] * r
+    tau0 -= mass * (wv0 + wwg0)
+    tau1 -= mass * (wv1 + wwg1)
+    tau2 -= mass * (wv2 + wwg2)
+    iw0 = par[P_IA] * p + par[P_IA + 1] * q + par[P_IA + 2] * r
+    iw1 = par[P_IA + 3] * p + par[P_IA + 4] * q + par[P_IA + 5] * r
+    iw2 = par[P_IA + 6] * p + par[P_IA + 7] * q + par[P_IA + 8] * r
     c0, c1, c2 = _cross3(p, q, r, iw0, iw1, iw2)
     d0, d1, d2 = _cross3(g0, g1, g2, wv0, wv1, wv2)
-    tau[3] -= c0 + mass * d0
-    tau[4] -= c1 + mass * d1
-    tau[5] -= c2 + mass * d2
+    tau3 -= c0 + mass * d0
+    tau4 -= c1 + mass * d1
+    tau5 -= c2 + mass * d2
     # fluid radiation damping, then nu' = M^-1 tau
-    nu = ws[36:42]
-    nu[0], nu[1], nu[2], nu[3], nu[4], nu[5] = u, v, w, p, q, r
+    if par[P_RADIATION] != 0.0:
+        for a in range(6):
+            s = damp6[a, 0] * u
+            s += damp6[a, 1] * v
+            s += damp6[a, 2] * w
+            s += damp6[a, 3] * p
+            s += damp6[a, 4] * q
+            s += damp6[a, 5] * r
+            ws[3 + a] = s
+        tau0 -= ws[3]
+        tau1 -= ws[4]
+        tau2 -= ws[5]
+        tau3 -= ws[6]
+        tau4 -= ws[7]
+        tau5 -= ws[8]
     for a in range(6):
-        s = 0.0
-        for b in range(6):
-            s += damp6[a, b] * nu[b]
-        tau[a] -= s
-    for a in range(6):
-        s = 0.0
-        for b in range(6):
-            s += minv[a, b] * tau[b]
+        s = minv[a, 0] * tau0
+        s += minv[a, 1] * tau1
+        s += minv[a, 2] * tau2
+        s += minv[a, 3] * tau3
+        s += minv[a, 4] * tau4
+        s += minv[a, 5] * tau5
         out[6 + a] = s
     return status
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", _nrt=False)
+def linear_rhs(amat, z, out):
+    """``out = A z`` (the linear test systems of the integrators)."""
+    n = z.shape[0]
+    for i in range(n):
+        s = 0.0 * z[0]
+        for j in range(n):
+            s += amat[i, j] * z[j]
+        out[i] = s
+    return OK
+
+
+@njit(cache=True, error_model="numpy")
+def rhs_into(kind, arrays, yeq, z, thrust, spin, out):
+    """``out = z'`` at deviation ``z`` with thrust ``thrust`` (N) and spin ``spin`` (rad/s).
+
+    ``arrays`` is the tuple of :class:`~impstab.dynamics.system.DynamicSystem`. Allocates its
+    workspace per call: loops use :func:`model_rhs` with a workspace of their own.
+    """
+    if kind == KIND_LINEAR:
+        return linear_rhs(arrays[8], z, out)
+    rot, jinv, ws = workspace(z)
+    return model_rhs(arrays[0], arrays[1], arrays[2], arrays[3], arrays[4], arrays[5], arrays[6], arrays[7],
+                     yeq, z, thrust, spin, out, rot, jinv, ws)
+
+
+@njit(cache=True, error_model="numpy")
+def rhs_batch(kind, arrays, yeq, zs, thrust, spin, out, status):
+    """``out[k] = z'`` at each row ``zs[k]`` (real or complex), one workspace for all rows;
+    ``status[k]`` the row's status."""
+    if zs.shape[0] == 0:
+        return
+    rot, jinv, ws = workspace(zs[0])
+    pos, kmat, cmat, flags, laws = arrays[0], arrays[1], arrays[2], arrays[3], arrays[4]
+    par, minv, damp6, amat = arrays[5], arrays[6], arrays[7], arrays[8]
+    for k in range(zs.shape[0]):
+        if kind == KIND_LINEAR:
+            status[k] = linear_rhs(amat, zs[k], out[k])
+        else:
+            status[k] = model_rhs(pos, kmat, cmat, flags, laws, par, minv, damp6, yeq, zs[k], thrust, spin, out[k],
+                                  rot, jinv, ws)
+
+
+@njit(cache=True, error_model="numpy")
 def mount_loads_series(arrays, yeq, zs, out):
     """Mount forces (hull frame, N) and mount moments (N m) on the body for each state row of
     ``zs``; ``out`` has shape ``(n_samples, n_mounts, 6)``."""
-    mats = np.zeros((2, 3, 3))
-    ws = np.zeros(WS)
+    pos, kmat, cmat, flags, laws, par = arrays[0], arrays[1], arrays[2], arrays[3], arrays[4], arrays[5]
+    rot, jinv, ws = workspace(yeq)
     for k in range(zs.shape[0]):
-        _pose_into(arrays, yeq, zs[k], mats[0], mats[1], ws)
-        for i in range(arrays[0].shape[0]):
-            _mount_load(i, arrays, mats[0], mats[1], ws)
+        z = zs[k]
+        _pose_into(par, yeq, z, rot, jinv, ws)
+        vh0, vh1, vh2 = _rotate(rot, yeq[6] + z[6], yeq[7] + z[7], yeq[8] + z[8])
+        wh0, wh1, wh2 = _rotate(rot, yeq[9] + z[9], yeq[10] + z[10], yeq[11] + z[11])
+        x0, x1, x2 = yeq[0] + z[0], yeq[1] + z[1], yeq[2] + z[2]
+        for i in range(pos.shape[0]):
+            load = _mount_load(i, pos, kmat, cmat, flags, laws, rot, jinv, ws, x0, x1, x2, vh0, vh1, vh2,
+                               wh0, wh1, wh2)
             for a in range(6):
-                out[k, i, a] = ws[24 + a]
+                out[k, i, a] = load[a]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -44,18 +45,44 @@ def _finite(field: str, value, positive: bool = True) -> float:
     return v
 
 
-def fastest_mode(lin) -> tuple[float, str]:
-    """``(|lambda|_max (rad/s), dominant dof)`` of the linearized system ``lin``."""
+def _snubber_contact(model: Model, lin) -> np.ndarray | None:
+    """The stiffness every snubber adds in full contact, ``sum T(rho_i)^T (k_snub I) T(rho_i)``
+    at the arms of ``lin``'s pose (an upper bound of its tangent ``k_snub [ramp' n n^T +
+    ramp / |d| (I - n n^T)]``); None without snubbers."""
+    from ..kinematics import rigid_map
+
+    extra = np.zeros((6, 6))
+    found = False
+    for m in model.mounts:
+        law = m.nonlinear
+        if law is not None and law.has_snubber:
+            t = rigid_map(lin.rotation @ m.position)
+            extra += law.snubber_stiffness * (t.T @ t)
+            found = True
+    return extra if found else None
+
+
+def fastest_mode(lin, model: Model | None = None) -> tuple[float, str]:
+    """``(|lambda|_max (rad/s), dominant dof)`` of the linearized system ``lin``; with ``model``,
+    also of ``lin`` with every snubber of the model in full contact (a run that engages a stiff
+    snubber vibrates faster than the equilibrium's modes)."""
     vals, vecs = np.linalg.eig(lin.state_matrix())
     j = int(np.argmax(np.abs(vals)))
     shape = np.abs(vecs[:6, j]) * np.sqrt(np.diag(lin.M))
-    return float(np.abs(vals[j])), DOF_NAMES[int(np.argmax(shape))]
+    omega, mode = float(np.abs(vals[j])), DOF_NAMES[int(np.argmax(shape))]
+    extra = None if model is None else _snubber_contact(model, lin)
+    if extra is not None:
+        om, md = fastest_mode(replace(lin, K=lin.K + extra))
+        if om > omega:
+            omega, mode = om, f"{md} in snubber contact"
+    return omega, mode
 
 
 def default_step(model: Model, thrust: float) -> float:
     """Default fixed step (s) at constant thrust ``thrust`` (N): ``STEPS_PER_PERIOD`` per period of
-    the fastest mode of the system linearized at the static equilibrium."""
-    omega, _ = fastest_mode(linearize(model, float(thrust), "equilibrium"))
+    the fastest mode of the system linearized at the static equilibrium (with its snubbers in
+    full contact, when it has any)."""
+    omega, _ = fastest_mode(linearize(model, float(thrust), "equilibrium"), model)
     return 2 * math.pi / (STEPS_PER_PERIOD * omega)
 
 
@@ -139,12 +166,12 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
     if abs(yeq[4] + z0[4]) >= pitch_limit:
         raise ModelError("perturbation.displacement.pitch", z0[4], "initial pitch must stay below pitch_limit")
     # step from the fastest mode (at T(0), and at the extreme thrusts of a history)
-    omega, mode = fastest_mode(lin)
+    omega, mode = fastest_mode(lin, model)
     t_probe = history(np.linspace(0.0, duration, 257))
     for t_other in (float(np.max(t_probe)), float(np.min(t_probe))):
         if abs(t_other - t0_thrust) > 1e-6 * max(abs(t0_thrust), 1.0):
             try:
-                om, md = fastest_mode(linearize(model, t_other, "equilibrium"))
+                om, md = fastest_mode(linearize(model, t_other, "equilibrium"), model)
             except Exception:  # noqa: BLE001 - no equilibrium there: keep the value at T(0)
                 continue
             if om > omega:
@@ -202,7 +229,14 @@ def _assemble(model, history, solver, problem, raw, lin, yeq, length, omega, mod
         except Exception:  # noqa: BLE001 - no equilibrium at the final thrust
             lin_end = None
     linear_rate = None if lin_end is None else float(np.max(lin_end.eigenvalues().real))
-    growth = fit_run(raw.time, raw.z, length, fit_window, linear_rate, t_end)
+    offset = None
+    if lin_end is not None and lin_end is not lin:
+        # a history that ends at another thrust: the motion about the final equilibrium
+        offset = np.zeros(12)
+        offset[:3] = lin_end.displacement - yeq[:3]
+        offset[3:6] = np.asarray(matrix_to_euler_zyx(lin_end.rotation)) - yeq[3:6]
+    growth = fit_run(raw.time, raw.z, length, fit_window, linear_rate, t_end, omega_max=omega, offset=offset,
+                     thrusts=thrust_t)
     crit = None
     classification = "not computed"
     if critical_thrust is not False:

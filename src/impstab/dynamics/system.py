@@ -1,16 +1,31 @@
 """Packing a model (or a linear test system) for the compiled kernels, and Python entry points
-to the right-hand side and the mount loads."""
+to the right-hand side and the mount loads.
+
+:class:`NonlinearSystem` is the entry point for analyses built on the equations of motion (the
+Hopf coefficient, periodic orbits): the compiled right-hand side of :func:`simulate` (the one
+implementation, :func:`~impstab.dynamics.rhs.model_rhs`) on a batch of real or complex states,
+its exact Jacobian by complex step, and the static equilibrium state at a thrust.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
-from .rhs import (KIND_LINEAR, KIND_MODEL, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH, P_RT, P_TANG,
-                  PITCH_LIMIT, mount_loads_series, rhs_into)
+from ..model.mount_law import N_LAW
+from .rhs import (FLAG_LAW, FLAG_ROTATION, KIND_LINEAR, KIND_MODEL, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH,
+                  P_RADIATION, P_ROTATION, P_RT, P_TANG, PITCH_LIMIT, mount_loads_series, rhs_batch, rhs_into)
 
-__all__ = ["DynamicSystem", "pack_dynamics", "linear_dynamics", "evaluate_rhs", "mount_loads"]
+__all__ = ["DynamicSystem", "NonlinearSystem", "pack_dynamics", "linear_dynamics", "evaluate_rhs", "mount_loads",
+           "equilibrium_state", "STATE_NAMES", "COMPLEX_STEP"]
+
+#: the 12 states of the nonlinear model: position of A (hull frame, m), z-y-x Euler angles (rad),
+#: body-frame velocity of A (m/s) and angular velocity (rad/s)
+STATE_NAMES = ("X_A", "Y_A", "Z_A", "phi", "theta", "psi", "u", "v", "w", "p", "q", "r")
+#: imaginary step of the complex-step Jacobian (absolute, in each state's unit)
+COMPLEX_STEP = 1e-30
 
 
 @dataclass(frozen=True, eq=False)
@@ -35,8 +50,10 @@ def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
 
     pk = pack_model(model)
     nm = pk.positions.shape[0]
-    full = np.array([int(np.any(k[3:, :] != 0) or np.any(k[:, 3:] != 0) or np.any(c[3:, :] != 0)
-                         or np.any(c[:, 3:] != 0)) for k, c in zip(pk.stiffness, pk.damping)], dtype=np.int64)
+    rotational = [bool(np.any(k[3:, :] != 0) or np.any(k[:, 3:] != 0) or np.any(c[3:, :] != 0) or np.any(c[:, 3:] != 0))
+                  for k, c in zip(pk.stiffness, pk.damping)]
+    nonlinear = np.any(pk.laws[:, 3:] != 0.0, axis=1)
+    flags = np.array([FLAG_ROTATION * r + FLAG_LAW * int(nl) for r, nl in zip(rotational, nonlinear)], dtype=np.int64)
     par = np.zeros(N_PAR)
     body = model.body
     par[P_MASS] = body.mass
@@ -47,10 +64,12 @@ def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
     par[P_TANG] = pk.tangency
     par[P_JP] = pk.polar_inertia
     par[P_PITCH] = float(pitch_limit)
+    par[P_ROTATION] = float(any(rotational))
+    par[P_RADIATION] = float(np.any(pk.damp6 != 0.0))
     arrays = (
         np.ascontiguousarray(pk.positions), np.ascontiguousarray(pk.stiffness),
-        np.ascontiguousarray(pk.damping), full, par, np.ascontiguousarray(np.linalg.inv(pk.mass6)),
-        np.ascontiguousarray(pk.damp6), np.zeros((1, 1)),
+        np.ascontiguousarray(pk.damping), flags, np.ascontiguousarray(pk.laws), par,
+        np.ascontiguousarray(np.linalg.inv(pk.mass6)), np.ascontiguousarray(pk.damp6), np.zeros((1, 1)),
     )
     return DynamicSystem(KIND_MODEL, arrays, 12, nm, float(pk.length_scale))
 
@@ -60,7 +79,7 @@ def linear_dynamics(amat) -> DynamicSystem:
     amat = np.ascontiguousarray(amat, dtype=float)
     n = amat.shape[0]
     arrays = (np.zeros((0, 3)), np.zeros((0, 6, 6)), np.zeros((0, 6, 6)), np.zeros(0, dtype=np.int64),
-              np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat)
+              np.zeros((0, N_LAW)), np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat)
     return DynamicSystem(KIND_LINEAR, arrays, n, 0)
 
 
@@ -70,6 +89,111 @@ def evaluate_rhs(system: DynamicSystem, yeq, z, thrust: float, spin: float = 0.0
     status = rhs_into(system.kind, system.arrays, np.ascontiguousarray(yeq, dtype=float),
                       np.ascontiguousarray(z, dtype=float), float(thrust), float(spin), out)
     return out, int(status)
+
+
+def equilibrium_state(model, thrust: float):
+    """The static equilibrium at thrust ``thrust`` (N) as a state ``(eta, nu)`` (12,), with
+    ``nu = 0``, and the equilibrium linearization there (a
+    :class:`~impstab.linear.system.LinearSystem`). Raises NumericalError where there is none."""
+    from ..kinematics import matrix_to_euler_zyx
+    from ..linear.linearize import linearize
+
+    lin = linearize(model, float(thrust), "equilibrium")
+    y = np.zeros(12)
+    y[:3] = lin.displacement
+    y[3:6] = matrix_to_euler_zyx(lin.rotation)
+    return y, lin
+
+
+@dataclass(frozen=True, eq=False)
+class NonlinearSystem:
+    """The nonlinear equations of motion ``y' = f(y; T)`` of a model, as :func:`simulate` integrates them.
+
+    The state is ``y = (X_A, Y_A, Z_A, phi, theta, psi, u, v, w, p, q, r)`` (:data:`STATE_NAMES`):
+    position of the reference point A from its unloaded place (hull frame, m), z-y-x Euler angles
+    of the body (rad), body-frame velocity of A (m/s) and angular velocity (rad/s). The thrust
+    ``T`` (N) is the parameter; the propeller spin follows the model's speed law unless given.
+
+    Every evaluation runs the compiled right-hand side of the simulation (one implementation),
+    on real or complex128 states: the code is analytic in the state, so ``f`` of a complex state
+    is the analytic continuation of ``f``, and complex-step or Cauchy-integral derivatives of it
+    are exact to rounding. Guards compare real parts only: the pitch guard (``|Re theta|`` at
+    ``pitch_limit``; the result is still computed, NaN only where ``cos theta`` vanishes) and the
+    snubber's contact test ``Re(d . d) > c^2`` (its force uses ``|d| = sqrt(d . d)``, analytic
+    away from ``d = 0``). A derivative taken exactly at the snubber's contact or at an end of its
+    smoothing interval is one-sided (the law is C2 there, not analytic).
+
+    Examples
+    --------
+    >>> ns = NonlinearSystem.from_model(model)
+    >>> y0 = ns.equilibrium(9000.0)                  # (12,)
+    >>> ns.rhs(y0, 9000.0)                           # ~0
+    >>> ns.jacobian(y0, 9000.0)                      # (12, 12), exact
+    >>> ns.rhs(y0 + 1e-3j * v, 9000.0)               # complex state
+    """
+
+    model: object
+    pitch_limit: float = PITCH_LIMIT
+    system: DynamicSystem = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "system", pack_dynamics(self.model, self.pitch_limit))
+
+    @classmethod
+    def from_model(cls, model, pitch_limit: float = PITCH_LIMIT) -> "NonlinearSystem":
+        return cls(model, pitch_limit)
+
+    n_states = 12
+
+    def spin(self, thrust: float) -> float:
+        """Propeller speed Omega (rad/s) at thrust ``thrust`` (N), by the model's speed law."""
+        return float(self.model.propeller.spin(float(thrust), self.model.thrust.operating))
+
+    def equilibrium(self, thrust: float) -> NDArray[np.float64]:
+        """The static equilibrium state at thrust ``thrust`` (N): ``(X_A, Xi, 0)`` (12,); the
+        continuation and Newton method of the linear analyses (:func:`equilibrium_state`)."""
+        return equilibrium_state(self.model, thrust)[0]
+
+    def rhs(self, states, thrust: float, spin: float | None = None, deviation_from=None):
+        """``f(y; T)`` at each state.
+
+        Parameters
+        ----------
+        states : (12,) or (n, 12) array, float or complex
+            Absolute states ``y``, or deviations from ``deviation_from`` when it is given.
+        thrust : float
+            Thrust T (N).
+        spin : float, optional
+            Propeller speed (rad/s); default the model's speed law at ``thrust``.
+        deviation_from : (12,) real array, optional
+            A base state ``y0``: ``states`` are then ``y - y0`` (the integrators' form).
+
+        Returns
+        -------
+        ndarray of the states' shape and dtype (complex128 for complex states): ``y'``.
+        """
+        states = np.asarray(states)
+        cplx = np.iscomplexobj(states)
+        zs = np.ascontiguousarray(np.atleast_2d(states), dtype=complex if cplx else float)
+        if zs.shape[-1] != 12 or zs.ndim != 2:
+            raise ValueError(f"states must have shape (12,) or (n, 12), not {states.shape}")
+        base = np.zeros(12) if deviation_from is None else np.ascontiguousarray(deviation_from, dtype=float)
+        out = np.empty_like(zs)
+        status = np.zeros(zs.shape[0], dtype=np.int64)
+        spin = self.spin(thrust) if spin is None else float(spin)
+        rhs_batch(self.system.kind, self.system.arrays, base, zs, float(thrust), spin, out, status)
+        return out.reshape(states.shape)
+
+    def jacobian(self, states, thrust: float, spin: float | None = None, deviation_from=None):
+        """``df/dy`` at each state by complex step (exact to rounding): (12, 12) or (n, 12, 12)."""
+        states = np.asarray(states, dtype=float)
+        ys = np.atleast_2d(states)
+        n = ys.shape[0]
+        probe = np.repeat(ys[:, None, :], 12, axis=1).astype(complex)
+        probe[:, np.arange(12), np.arange(12)] += 1j * COMPLEX_STEP
+        f = self.rhs(probe.reshape(n * 12, 12), thrust, spin, deviation_from).reshape(n, 12, 12)
+        jac = np.swapaxes(f.imag, 1, 2) / COMPLEX_STEP
+        return jac[0] if states.ndim == 1 else jac
 
 
 def mount_loads(system: DynamicSystem, yeq, zs):

@@ -3,6 +3,12 @@
 Used by the force law and its tangent (:mod:`impstab.linear.tangent`), the nonlinear equations
 of motion and the plain-NumPy helpers of :mod:`impstab.kinematics`. Compiled with numba
 (``cache=True``); with ``NUMBA_DISABLE_JIT=1`` the same code runs as plain Python.
+
+``_log_so3_into`` and ``_jinv_into`` write into arrays the caller owns (no allocation, for the
+right-hand side of the equations of motion) and are type-generic: written with the analytic
+functions of :mod:`impstab.kinematics.scalar` and branches on real parts, they also run on a
+complex rotation matrix (exact complex-step derivatives). ``_log_so3`` and ``_jinv`` return new
+arrays and call them.
 """
 
 from __future__ import annotations
@@ -12,7 +18,10 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["_skew", "_cross", "_exp_so3", "_log_so3", "_jinv_coeffs", "_jinv", "_d_jinvT_w"]
+from .scalar import acos, cos, sin, sqrt
+
+__all__ = ["_skew", "_cross", "_exp_so3", "_log_so3", "_log_so3_into", "_jinv_coeffs", "_jinv", "_jinv_into",
+           "_d_jinvT_w"]
 
 
 @njit(cache=True)
@@ -50,41 +59,68 @@ def _exp_so3(phi):
     return np.eye(3) + a * s + b * (s @ s)
 
 
+@njit(cache=True, inline="always")
+def _log_so3_into(rot, w):
+    """Rotation vector of ``rot`` (angle below pi) into ``w[0:3]``."""
+    c = 0.5 * (rot[0, 0] + rot[1, 1] + rot[2, 2] - 1.0)
+    if c.real > 1.0:  # rounding beyond the identity: clamp the real part
+        c = c - (c.real - 1.0)
+    elif c.real < -1.0:
+        c = c - (c.real + 1.0)
+    theta = acos(c)
+    if theta.real < 1e-4:
+        scale = 1.0 + theta * theta / 6.0
+    else:
+        scale = theta / sin(theta)
+    w[0] = 0.5 * (rot[2, 1] - rot[1, 2]) * scale
+    w[1] = 0.5 * (rot[0, 2] - rot[2, 0]) * scale
+    w[2] = 0.5 * (rot[1, 0] - rot[0, 1]) * scale
+
+
 @njit(cache=True)
 def _log_so3(rot):
-    c = 0.5 * (rot[0, 0] + rot[1, 1] + rot[2, 2] - 1.0)
-    c = min(1.0, max(-1.0, c))
-    theta = math.acos(c)
     w = np.empty(3)
-    w[0] = 0.5 * (rot[2, 1] - rot[1, 2])
-    w[1] = 0.5 * (rot[0, 2] - rot[2, 0])
-    w[2] = 0.5 * (rot[1, 0] - rot[0, 1])
-    if theta < 1e-4:
-        return w * (1.0 + theta * theta / 6.0)
-    return w * (theta / math.sin(theta))
+    _log_so3_into(rot, w)
+    return w
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _jinv_coeffs(theta):
     # c(theta) = 1/theta^2 - cot(theta/2) / (2 theta);  c1 = c'(theta) / theta
-    if theta < 0.25:
+    if theta.real < 0.25:
         t2 = theta * theta
         c = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2**3 / 1209600.0 + t2**4 / 47900160.0
         c1 = 1.0 / 360.0 + t2 / 7560.0 + t2 * t2 / 201600.0 + t2**3 / 5987520.0
         return c, c1
     half = 0.5 * theta
-    cot = math.cos(half) / math.sin(half)
+    cot = cos(half) / sin(half)
     c = 1.0 / theta**2 - cot / (2.0 * theta)
-    dc = -2.0 / theta**3 + 1.0 / (4.0 * theta * math.sin(half) ** 2) + cot / (2.0 * theta**2)
+    dc = -2.0 / theta**3 + 1.0 / (4.0 * theta * sin(half) ** 2) + cot / (2.0 * theta**2)
     return c, dc / theta
+
+
+@njit(cache=True, inline="always")
+def _jinv_into(phi, out):
+    """``J_l^{-1}(phi) = I - S(phi) / 2 + c(theta) S(phi)^2`` into the 3 x 3 ``out``."""
+    t2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]
+    c, _ = _jinv_coeffs(sqrt(t2))
+    for i in range(3):
+        for j in range(3):
+            # S(phi)^2 = phi phi^T - |phi|^2 I
+            out[i, j] = c * (phi[i] * phi[j] - (t2 if i == j else 0.0)) + (1.0 if i == j else 0.0)
+    out[0, 1] += 0.5 * phi[2]
+    out[0, 2] -= 0.5 * phi[1]
+    out[1, 0] -= 0.5 * phi[2]
+    out[1, 2] += 0.5 * phi[0]
+    out[2, 0] += 0.5 * phi[1]
+    out[2, 1] -= 0.5 * phi[0]
 
 
 @njit(cache=True)
 def _jinv(phi):
-    theta = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
-    c, _ = _jinv_coeffs(theta)
-    s = _skew(phi)
-    return np.eye(3) - 0.5 * s + c * (s @ s)
+    out = np.empty((3, 3))
+    _jinv_into(phi, out)
+    return out
 
 
 @njit(cache=True)

@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from ..errors import ModelError, NumericalError
 from ..model.model import LINEARIZATIONS, Model
+from ..model.mount_law import LAW_AXIS, LAW_CLEARANCE, LAW_K3_AXIAL, LAW_K3_SHEAR, N_LAW
 from .system import LinearSystem
 from .tangent import classical_forms, linearize_batch
 
@@ -40,6 +41,13 @@ class PackedModel:
     speed_law: str
     operating: float | None
     length_scale: float
+    #: ``(n_mounts, N_LAW)`` nonlinear mount laws (:mod:`impstab.model.mount_law`); zeros: linear
+    laws: Array | None = None
+
+    @property
+    def nonlinear(self) -> bool:
+        """True when a mount carries a nonlinear law."""
+        return self.laws is not None and bool(np.any(self.laws[:, LAW_K3_AXIAL:] != 0.0))
 
     def spins(self, thrusts: Array) -> Array:
         """Propeller speed Omega (rad/s) at each thrust."""
@@ -64,6 +72,10 @@ def pack_model(model: Model, damped: bool = True, fluid_frequency: float = 0.0) 
     if not damped:
         damping = np.zeros_like(damping)
     arms = np.concatenate([np.linalg.norm(positions, axis=1), [np.linalg.norm(model.thrust.point)]])
+    laws = np.zeros((len(model.mounts), N_LAW))
+    for i, mount in enumerate(model.mounts):
+        if mount.is_nonlinear:
+            laws[i] = mount.nonlinear.packed()
     return PackedModel(
         mass6=np.ascontiguousarray(model.body.mass_matrix() + added),
         damp6=np.ascontiguousarray(radiation),
@@ -79,26 +91,33 @@ def pack_model(model: Model, damped: bool = True, fluid_frequency: float = 0.0) 
         speed_law=model.propeller.speed_law,
         operating=model.thrust.operating,
         length_scale=float(max(arms.max(initial=0.0), 1e-3)),
+        laws=laws,
     )
 
 
 def affine_forms(
     mass6: Array, damp6: Array, positions: Array, stiffness: Array, damping: Array, e_dir: Array,
     r_thrust: Array, tangency: Array, preload: bool, length_scale: Array, equilibrium: bool,
+    laws: Array | None = None,
 ):
     """The affine form ``K = K0 + T K1`` of many designs at once (leading design axis ``n``).
 
     Inputs are :class:`PackedModel` fields stacked over designs (``positions (n, nm, 3)``, ...,
-    ``tangency`` and ``length_scale`` of shape ``(n,)``). Returns ``M, D, K0, K1, G1`` (each
-    ``(n, 6, 6)``; ``G1`` per unit ``I_p Omega``) and ``affine (n,)``: whether K is exactly
-    linear in T for that design.
+    ``tangency`` and ``length_scale`` of shape ``(n,)``, ``laws (n, nm, N_LAW)`` or None for
+    linear mounts). Returns ``M, D, K0, K1, G1`` (each ``(n, 6, 6)``; ``G1`` per unit
+    ``I_p Omega``) and ``affine (n,)``: whether K is exactly linear in T for that design.
 
     The classical form is linear by construction; its two parts are formed directly by
     :func:`~impstab.linear.tangent.classical_forms` (the matrices of :func:`linearize_batch` to
-    rounding). The equilibrium form is linear too when linear statics leaves the body unrotated
-    (symmetric layouts, thrust through the elastic centre): then ``R0 = I`` solves the nonlinear
-    statics exactly, the mount forces are the linear ones and the tangent equals the classical
-    matrices. ``length_scale`` (m) converts that rotation to a displacement for the test.
+    rounding). The classical form sees only the linear springs: a nonlinear mount law's tangent
+    at zero deflection is the linear one. The equilibrium form is linear too when linear statics
+    leaves the body unrotated (symmetric layouts, thrust through the elastic centre): then
+    ``R0 = I`` solves the nonlinear statics exactly, the mount forces are the linear ones and the
+    tangent equals the classical matrices. ``length_scale`` (m) converts that rotation to a
+    displacement for the test. With nonlinear mount laws that is exact only where the law adds
+    nothing along the whole path: every mount deflects by ``d = T u1`` (``u1`` the translation
+    per newton), so a cubic axial term needs ``a . u1 = 0``, a cubic shear term
+    ``u1 - (a . u1) a = 0``, and a snubber (which engages at some thrust) is never affine.
     """
     m, d, g, k0, k1, q0 = classical_forms(
         mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, np.asarray(tangency, dtype=float), preload
@@ -106,7 +125,17 @@ def affine_forms(
     affine = np.ones(len(m), dtype=bool)
     if equilibrium:
         rot = np.abs(q0[:, 3:]).max(axis=-1) * length_scale
-        affine = rot <= 1e-13 * np.maximum(np.abs(q0[:, :3]).max(axis=-1), 1e-300)
+        size = np.maximum(np.abs(q0[:, :3]).max(axis=-1), 1e-300)
+        affine = rot <= 1e-13 * size
+        if laws is not None and np.any(laws[..., LAW_K3_AXIAL:] != 0.0):
+            u1 = q0[:, None, :3]
+            axis = laws[..., LAW_AXIS:LAW_AXIS + 3]
+            along = (axis * u1).sum(axis=-1)
+            across = np.linalg.norm(u1 - along[..., None] * axis, axis=-1)
+            tol = 1e-13 * size[:, None]
+            active = (((laws[..., LAW_K3_AXIAL] != 0.0) & (np.abs(along) > tol))
+                      | ((laws[..., LAW_K3_SHEAR] != 0.0) & (across > tol)) | (laws[..., LAW_CLEARANCE] > 0.0))
+            affine &= ~active.any(axis=-1)
     return m, d, k0, k1, g, affine
 
 
@@ -146,7 +175,7 @@ class ModelFamily:
         m, d, k0, k1, g1, affine = affine_forms(
             stack(pk.mass6), stack(pk.damp6), stack(pk.positions), stack(pk.stiffness), stack(pk.damping),
             stack(pk.e_dir), stack(pk.r_thrust), stack(pk.tangency), pk.preload, stack(pk.length_scale),
-            lin == "equilibrium",
+            lin == "equilibrium", None if pk.laws is None else stack(pk.laws),
         )
         return (m[0], d[0], k0[0], k1[0], g1[0]) if affine[0] else None
 
@@ -176,7 +205,7 @@ class ModelFamily:
         m, d, g, k, u0, r0, ok = linearize_batch(
             thrusts, pk.spins(thrusts), pk.mass6, pk.damp6, pk.positions, pk.stiffness, pk.damping,
             pk.e_dir, pk.r_thrust, pk.tangency, pk.preload, pk.polar_inertia,
-            self.linearization == "equilibrium", pk.length_scale, t_start, u_start, r_start,
+            self.linearization == "equilibrium", pk.length_scale, t_start, u_start, r_start, pk.laws,
         )
         self._remember(thrusts[ok], u0[ok], r0[ok])
         if not ok.all():

@@ -9,6 +9,9 @@ Each mount is an elastic element with potential ``V = 1/2 e^T k e`` on its body-
 ``e = (u + R r - r, phi)`` with ``phi = log(R)`` (rotation vector), so that
 ``Q_i = -B_i^T k_i e_i``, ``B_i = [[I, -S(rho_i)], [0, J_l^{-1}(phi)]]``, ``rho_i = R r_i``.
 For the paper's mount (translation block only) this is ``f_i = -k_i d_i`` at the arm ``rho_i``.
+A nonlinear mount law (:mod:`impstab.model.mount_law`) adds its potential ``V_nl(d_i)`` on the
+translation deflection: ``g_i[:3] += grad V_nl`` and ``k_i[:3, :3] += hess V_nl`` in both the
+force and the elastic tangent (the preload part uses the total force).
 The tangent is ``sum B_i^T k_i B_i`` plus the preload (geometric) part
 ``-S(f_i) S(rho_i) + H(phi, g_phi) J_l^{-1}`` plus the thrust part
 ``[[0, S(f_F)], [0, -S(f_F + f_D) S(rho_T) + S(rho_T) S(f_F)]]``.
@@ -23,16 +26,32 @@ import numpy as np
 from numba import njit
 
 from ..kinematics.so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _skew
+from ..model.mount_law import LAW_K3_AXIAL, N_LAW, law_gradient, law_hessian
 
-__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_forms", "MAX_PREDICTOR"]
+__all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_forms", "MAX_PREDICTOR",
+           "NEWTON_FLOOR"]
 
 #: largest accepted predictor step of the continuation (rad, or fraction of the length scale)
 MAX_PREDICTOR = 0.02
+#: Newton corrections below this (relative to the length scale, or rad) that stop shrinking are
+#: rounding: the equilibrium is converged
+NEWTON_FLOOR = 1e-9
 
 
 @njit(cache=True)
-def pose_forces(u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, tangency):
+def _has_law(laws, i):
+    for a in range(LAW_K3_AXIAL, N_LAW):
+        if laws[i, a] != 0.0:
+            return True
+    return False
+
+
+@njit(cache=True)
+def pose_forces(u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, tangency, laws):
     """Generalized forces and tangent pieces at the pose ``(u, rot)`` under thrust ``T``.
+
+    ``laws`` is the ``(n_mounts, N_LAW)`` table of nonlinear mount laws (rows of zeros: linear
+    mounts).
 
     Returns
     -------
@@ -50,6 +69,7 @@ def pose_forces(u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, 
     d_m = np.zeros((6, 6))
     phi = _log_so3(rot)
     jinv = _jinv(phi)
+    hess = np.zeros((3, 3))
     for i in range(nm):
         r = positions[i]
         rho = rot @ r
@@ -63,12 +83,21 @@ def pose_forces(u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, 
         b[:3, 3:] = -_skew(rho)
         b[3:, 3:] = jinv
         g = stiffness[i] @ e
+        k_i = stiffness[i]
+        if _has_law(laws, i):
+            g0, g1, g2 = law_gradient(laws, i, e[0], e[1], e[2])
+            g[0] += g0
+            g[1] += g1
+            g[2] += g2
+            law_hessian(laws, i, e[0], e[1], e[2], hess)
+            k_i = stiffness[i].copy()
+            k_i[:3, :3] += hess
         f = -g[:3]
         gphi = g[3:].copy()
         m = -(jinv.T @ gphi)
         q_force[:3] += f
         q_force[3:] += _cross(rho, f) + m
-        k_el += b.T @ stiffness[i] @ b
+        k_el += b.T @ k_i @ b
         d_m += b.T @ damping[i] @ b
         k_pre[3:, 3:] += -_skew(f) @ _skew(rho)
         if gphi[0] != 0.0 or gphi[1] != 0.0 or gphi[2] != 0.0:
@@ -86,7 +115,7 @@ def pose_forces(u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, 
 
 @njit(cache=True)
 def static_equilibrium_packed(
-    t_from, t_to, u0, rot0, positions, stiffness, damping, e_dir, r_thrust, tangency, length_scale
+    t_from, t_to, u0, rot0, positions, stiffness, damping, e_dir, r_thrust, tangency, length_scale, laws
 ):
     """Follow the static equilibrium from ``(u0, rot0)`` at thrust ``t_from`` to ``t_to``.
 
@@ -96,6 +125,14 @@ def static_equilibrium_packed(
     than half of it); otherwise the step is subdivided. A jump to a distant branch is
     thereby refused: where no nearby equilibrium exists (a limit point) the result is not
     converged. Returns ``(u, rot, iterations, converged)``.
+
+    Convergence: a correction below ``1e-13`` (relative to the length scale, or rad) twice, or
+    one below ``NEWTON_FLOOR`` that is no smaller than the one before it. The second rule
+    recognises the rounding floor of the equilibrium: where the mounts are very soft against
+    the thrust (a shear stiffness of 1 N/m under 8 kN) rounding of the forces alone moves the
+    pose by more than ``1e-13``, and Newton's corrections stop shrinking there instead of
+    falling below a fixed tolerance. Converging Newton corrections always shrink (quadratically,
+    or by a factor 1/2 at a limit point), so a correction that does not shrink is rounding.
     """
     total = 0
     u = u0.copy()
@@ -110,9 +147,10 @@ def static_equilibrium_packed(
             small = 0
             first = -1.0
             later = 0.0
+            previous = np.inf
             for it in range(60):
                 qf, kel, kpre, kthr, _ = pose_forces(
-                    u, rot, load, positions, stiffness, damping, e_dir, r_thrust, tangency
+                    u, rot, load, positions, stiffness, damping, e_dir, r_thrust, tangency, laws
                 )
                 step = np.linalg.solve(kel + kpre + kthr, qf)
                 total += 1
@@ -125,6 +163,10 @@ def static_equilibrium_packed(
                     later += size
                 if first > MAX_PREDICTOR or later > 0.5 * first + 1e-10:
                     break
+                if size < NEWTON_FLOOR and size >= previous:
+                    converged = True  # the rounding floor: keep the pose before this correction
+                    break
+                previous = size
                 u = u + step[:3]
                 rot = _exp_so3(step[3:]) @ rot
                 if size < 1e-13:
@@ -151,9 +193,13 @@ def _block_rotate(mat, rot):
 @njit(cache=True)
 def linearize_batch(
     thrusts, spins, mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency,
-    preload, polar_inertia, equilibrium, length_scale, t_start=0.0, u_start=None, r_start=None,
+    preload, polar_inertia, equilibrium, length_scale, t_start=0.0, u_start=None, r_start=None, laws=None,
 ):
     """Linearized matrices ``M, D, G, K`` (stacks ``(N, 6, 6)``) at each thrust.
+
+    ``laws``: the ``(n_mounts, N_LAW)`` nonlinear mount laws (None: linear mounts); they enter
+    the equilibrium form only (the classical form is the tangent at zero deflection, where a
+    law adds nothing).
 
     ``equilibrium=True``: at the nonlinear static equilibrium, followed by continuation along
     the sorted thrusts from the equilibrium ``(u_start, r_start)`` at ``t_start`` (default the
@@ -172,6 +218,10 @@ def linearize_batch(
     r_out = np.zeros((n, 3, 3))
     ok_out = np.ones(n, dtype=np.bool_)
     nm = positions.shape[0]
+    if laws is None:
+        law_table = np.zeros((nm, N_LAW))
+    else:
+        law_table = laws
     # condensed elastic stiffness at rest (classical statics)
     k_c = np.zeros((6, 6))
     eye3 = np.eye(3)
@@ -191,7 +241,7 @@ def linearize_batch(
         if equilibrium:
             u, rot, _, conv = static_equilibrium_packed(
                 t_prev, thrust, u_prev, r_prev, positions, stiffness, damping, e_dir, r_thrust,
-                tangency, length_scale,
+                tangency, length_scale, law_table,
             )
             ok_out[idx] = conv
             if conv:
@@ -199,7 +249,7 @@ def linearize_batch(
                 r_prev = rot
                 t_prev = thrust
             qf, kel, kpre, kthr, dm = pose_forces(
-                u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, tangency
+                u, rot, thrust, positions, stiffness, damping, e_dir, r_thrust, tangency, law_table
             )
         else:
             u = np.zeros(3)

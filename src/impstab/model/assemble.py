@@ -21,7 +21,7 @@ from .body import RigidBody
 from .isolation_specs import excitation_from_spec, foundation_from_spec
 from .fluid import FluidLoading, Hull
 from .model import AnalysisSettings, Model
-from .mounts import Mount, axial_shear_matrix, elastic_stiffness, ring_positions
+from .mounts import Mount, NonlinearLaw, axial_shear_matrix, elastic_stiffness, ring_positions
 from .reference import DOC_PATH
 from .schema import UNION_TAGS, ModelFile, mark_at
 from .schema_doc import clean_loc, unknown_key_rule
@@ -167,15 +167,37 @@ def _inertia(spec: list, field: str) -> np.ndarray:
     return inertia
 
 
+_LAW_KEYS = ("k3_axial", "k3_shear", "snubber_clearance", "snubber_stiffness")
+
+
+def _nonlinear_law(spec, axis: np.ndarray, field: str) -> NonlinearLaw | None:
+    """The mount's nonlinear law from its keys (None when they add nothing); checks the snubber
+    pair: a clearance needs a stiffness > 0, and a stiffness needs a clearance."""
+    clearance, stiffness = spec.snubber_clearance, spec.snubber_stiffness
+    if clearance > 0.0 and not stiffness > 0.0:
+        raise ModelError(f"{field}.snubber_stiffness", stiffness,
+                         f"must be > 0 when snubber_clearance is given ({clearance:g} m)")
+    if stiffness > 0.0 and not clearance > 0.0:
+        raise ModelError(f"{field}.snubber_clearance", clearance,
+                         f"must be > 0 when snubber_stiffness is given ({stiffness:g} N/m); 0 means no snubber")
+    law = NonlinearLaw(axis, spec.k3_axial, spec.k3_shear, clearance, stiffness)
+    return None if law.is_linear else law
+
+
 def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
     mounts: list[Mount] = []
     for i, m in enumerate(doc.mounts):
         f = f"mounts[{i}]"
         pos = np.asarray(m.position, float)
+        law = None
         if m.stiffness is not None:
             for key in ("k_axial", "k_shear"):
                 if getattr(m, key) is not None:
                     raise ModelError(f"{f}.{key}", getattr(m, key), "give either 'stiffness' (6x6) or k_axial/k_shear, not both")
+            for key in _LAW_KEYS:
+                if getattr(m, key) != 0.0:
+                    raise ModelError(f"{f}.{key}", getattr(m, key),
+                                     "is read only with k_axial/k_shear (an axial-shear mount), not with a full 6x6 'stiffness'")
             k6 = np.asarray(m.stiffness, float)
             _symmetric_psd(k6, f"{f}.stiffness")
         else:
@@ -185,6 +207,7 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             axis = unit_vector(m.axis, f"{f}.axis")
             k6 = np.zeros((6, 6))
             k6[:3, :3] = axial_shear_matrix(axis, m.k_axial, m.k_shear)
+            law = _nonlinear_law(m, axis, f)
         if m.damping is not None:
             if m.c_axial or m.c_shear:
                 raise ModelError(f"{f}.damping", "6x6", "give either 'damping' (6x6) or c_axial/c_shear, not both")
@@ -194,13 +217,16 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             axis = unit_vector(m.axis, f"{f}.axis")
             c6 = np.zeros((6, 6))
             c6[:3, :3] = axial_shear_matrix(axis, m.c_axial, m.c_shear)
-        mounts.append(Mount(pos, k6, c6, unit_vector(m.axis, f"{f}.axis"), m.rated_force, m.max_deflection))
+        mounts.append(Mount(pos, k6, c6, unit_vector(m.axis, f"{f}.axis"), m.rated_force, m.max_deflection,
+                            nonlinear=law))
     for i, ring in enumerate(doc.mount_rings):
         f = f"mount_rings[{i}]"
         axis = unit_vector(ring.axis, f"{f}.axis")
+        law = _nonlinear_law(ring, axis, f)
         for pos in ring_positions(ring.count, ring.radius, ring.x, ring.start_angle):
             mount = Mount.axial_shear(pos, axis, ring.k_axial, ring.k_shear, ring.c_axial, ring.c_shear)
-            mounts.append(replace(mount, rated_force=ring.rated_force, max_deflection=ring.max_deflection))
+            mounts.append(replace(mount, rated_force=ring.rated_force, max_deflection=ring.max_deflection,
+                                  nonlinear=law))
     if not mounts:
         raise ModelError("mounts", [], "the model needs at least one mount or mount ring")
     if len(mounts) > MAX_MOUNTS:

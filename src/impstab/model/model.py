@@ -92,6 +92,11 @@ class Model:
         return mount_damping(self.mounts)
 
     @property
+    def is_nonlinear(self) -> bool:
+        """True when a mount carries a nonlinear law (cubic springs or a snubber)."""
+        return any(m.is_nonlinear for m in self.mounts)
+
+    @property
     def is_damped(self) -> bool:
         return any(np.any(m.damping != 0) for m in self.mounts)
 

@@ -5,6 +5,10 @@ deflection of its body end (translation of the attachment point, then rotation),
 frame. The paper's mount (axial and shear springs and dashpots along a unit axis ``a``) is the
 special case ``k = k_ax a a^T + k_sh (I - a a^T)`` in the translation block and zero rotation
 block; a beam or measured mount gives the full 6 x 6 matrix at its body end.
+
+A mount may also carry a :class:`NonlinearLaw` (cubic axial and shear springs, a snubber) that
+adds to the forces of its linear springs on the translation deflection of its body end; see
+:mod:`impstab.model.mount_law` for the force law.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ from numpy.typing import NDArray
 
 from ..kinematics import rigid_map6
 
-__all__ = ["Mount", "axial_shear_matrix", "ring_positions", "condense", "elastic_stiffness", "mount_damping"]
+__all__ = ["Mount", "NonlinearLaw", "axial_shear_matrix", "ring_positions", "condense", "elastic_stiffness", "mount_damping"]
 
 Array = NDArray[np.float64]
 
@@ -42,6 +46,67 @@ def axial_shear_matrix(axis: Array, axial: float | Array, shear: float | Array) 
 
 
 @dataclass(frozen=True, eq=False)
+class NonlinearLaw:
+    """Nonlinear part of a mount's force law (DESIGN "Model file, round 2 additions").
+
+    Parameters
+    ----------
+    axis : (3,) array
+        Mount axis ``a`` (hull frame; normalised here).
+    k3_axial : float
+        Cubic axial stiffness (N/m^3): axial force ``-k3_axial d_a^3`` (negative: softening).
+    k3_shear : float
+        Cubic shear stiffness (N/m^3): shear force ``-k3_shear |d_s|^2 d_s``.
+    snubber_clearance : float
+        Clearance ``c`` (m) beyond which the motion limiter engages on ``|d|``; 0: no snubber.
+    snubber_stiffness : float
+        Snubber stiffness (N/m): force ``-k_snub ramp(|d| - c) d / |d|``, ramp smoothed (C2)
+        over ``0.05 c``. Required > 0 with a clearance, and 0 without one.
+    """
+
+    axis: Array
+    k3_axial: float = 0.0
+    k3_shear: float = 0.0
+    snubber_clearance: float = 0.0
+    snubber_stiffness: float = 0.0
+
+    def __post_init__(self) -> None:
+        axis = np.asarray(self.axis, dtype=float).reshape(3)
+        norm = float(np.linalg.norm(axis))
+        if not norm > 0.0 or not np.isfinite(norm):
+            raise ValueError(f"NonlinearLaw.axis must be a finite non-zero vector, not {axis.tolist()}")
+        object.__setattr__(self, "axis", _frozen(axis / norm))
+        for name in ("k3_axial", "k3_shear", "snubber_clearance", "snubber_stiffness"):
+            value = float(getattr(self, name))
+            if not np.isfinite(value):
+                raise ValueError(f"NonlinearLaw.{name} must be finite, not {value}")
+            object.__setattr__(self, name, value)
+        if self.snubber_clearance < 0.0 or self.snubber_stiffness < 0.0:
+            raise ValueError("NonlinearLaw: snubber clearance and stiffness must be >= 0")
+        if (self.snubber_clearance > 0.0) != (self.snubber_stiffness > 0.0):
+            raise ValueError("NonlinearLaw: a snubber needs both a clearance > 0 and a stiffness > 0")
+
+    @property
+    def has_snubber(self) -> bool:
+        return self.snubber_clearance > 0.0
+
+    @property
+    def is_linear(self) -> bool:
+        """True when the law adds nothing (no cubic term, no snubber)."""
+        return self.k3_axial == 0.0 and self.k3_shear == 0.0 and not self.has_snubber
+
+    def packed(self) -> Array:
+        """The law as a row of :data:`impstab.model.mount_law.N_LAW` numbers for the kernels."""
+        from .mount_law import LAW_AXIS, LAW_CLEARANCE, LAW_K3_AXIAL, LAW_K3_SHEAR, LAW_SNUBBER, N_LAW
+
+        row = np.zeros(N_LAW)
+        row[LAW_AXIS:LAW_AXIS + 3] = self.axis
+        row[LAW_K3_AXIAL], row[LAW_K3_SHEAR] = self.k3_axial, self.k3_shear
+        row[LAW_CLEARANCE], row[LAW_SNUBBER] = self.snubber_clearance, self.snubber_stiffness
+        return row
+
+
+@dataclass(frozen=True, eq=False)
 class Mount:
     """One massless mount.
 
@@ -60,6 +125,9 @@ class Mount:
     rated_force, max_deflection : float or None
         Static force rating (N) and static deflection limit (m) of the mount, for the static
         load check (:func:`impstab.response.static_mount_loads`).
+    nonlinear : NonlinearLaw or None
+        Cubic springs and snubber acting on the translation deflection, in addition to
+        ``stiffness``; None (or a linear law): the mount is linear.
     """
 
     position: Array
@@ -68,6 +136,7 @@ class Mount:
     axis: Array = (1.0, 0.0, 0.0)  # type: ignore[assignment]
     rated_force: float | None = None
     max_deflection: float | None = None
+    nonlinear: NonlinearLaw | None = None
 
     def __repr__(self) -> str:
         from ..display import mount_text
@@ -90,13 +159,24 @@ class Mount:
         k_shear: float = 0.0,
         c_axial: float = 0.0,
         c_shear: float = 0.0,
+        k3_axial: float = 0.0,
+        k3_shear: float = 0.0,
+        snubber_clearance: float = 0.0,
+        snubber_stiffness: float = 0.0,
     ) -> "Mount":
-        """The paper's mount: uncoupled axial and shear spring and dashpot along ``axis``."""
+        """The paper's mount: uncoupled axial and shear spring and dashpot along ``axis``, with
+        an optional nonlinear law (cubic springs, snubber; see :class:`NonlinearLaw`)."""
         k = np.zeros((6, 6))
         c = np.zeros((6, 6))
         k[:3, :3] = axial_shear_matrix(axis, k_axial, k_shear)
         c[:3, :3] = axial_shear_matrix(axis, c_axial, c_shear)
-        return cls(np.asarray(position, float), k, c, axis)
+        law = NonlinearLaw(np.asarray(axis, float), k3_axial, k3_shear, snubber_clearance, snubber_stiffness)
+        return cls(np.asarray(position, float), k, c, axis, nonlinear=None if law.is_linear else law)
+
+    @property
+    def is_nonlinear(self) -> bool:
+        """True when the mount carries a nonlinear law (cubic springs or a snubber)."""
+        return self.nonlinear is not None and not self.nonlinear.is_linear
 
     @property
     def has_rotational_stiffness(self) -> bool:

@@ -70,6 +70,16 @@ MODEL_REFERENCE: dict[str, E] = {
                               "the operating thrust and warns above 1.", "mount rated force"),
     "mounts[].max_deflection": E("m", "Static deflection limit of the mount: `impstab check` reports |d| / "
                                  "max_deflection at the operating thrust and warns above 1.", "mount deflection limit"),
+    "mounts[].k3_axial": E("N/m^3", "Cubic axial stiffness: axial force -(k_axial d_a + k3_axial d_a^3) on the axial "
+                           "deflection d_a; negative softens. Axial-shear mounts only (not with stiffness); the linear "
+                           "analyses see it through the static equilibrium.", "mount cubic axial stiffness k3_axial"),
+    "mounts[].k3_shear": E("N/m^3", "Cubic shear stiffness: shear force -(k_shear + k3_shear |d_s|^2) d_s; negative "
+                           "softens. Axial-shear mounts only.", "mount cubic shear stiffness k3_shear"),
+    "mounts[].snubber_clearance": E("m", "Motion limiter: engages when the deflection |d| exceeds it, with the force "
+                                    "-snubber_stiffness ramp(|d| - clearance) d/|d|, ramp smoothed (C2) over 5 % of the "
+                                    "clearance; 0 means none, > 0 needs snubber_stiffness.", "snubber clearance"),
+    "mounts[].snubber_stiffness": E("N/m", "Stiffness of the motion limiter beyond its clearance; required > 0 with "
+                                    "snubber_clearance, and only with it.", "snubber stiffness"),
     # [[mount_rings]]
     "mount_rings": E("", "Rings of identical mounts, equally spaced around the axis (count mounts on a circle of "
                      "the given radius in the plane at x)."),
@@ -85,6 +95,14 @@ MODEL_REFERENCE: dict[str, E] = {
     "mount_rings[].rated_force": E("N", "Static force rating of each mount of the ring.", "mount rated force"),
     "mount_rings[].max_deflection": E("m", "Static deflection limit of each mount of the ring.",
                                       "mount deflection limit"),
+    "mount_rings[].k3_axial": E("N/m^3", "Cubic axial stiffness of each mount (negative softens), as for [[mounts]].",
+                                "mount cubic axial stiffness k3_axial"),
+    "mount_rings[].k3_shear": E("N/m^3", "Cubic shear stiffness of each mount (negative softens), as for [[mounts]].",
+                                "mount cubic shear stiffness k3_shear"),
+    "mount_rings[].snubber_clearance": E("m", "Motion limiter clearance of each mount (0: none), as for [[mounts]].",
+                                         "snubber clearance"),
+    "mount_rings[].snubber_stiffness": E("N/m", "Motion limiter stiffness of each mount; required > 0 with a "
+                                         "clearance.", "snubber stiffness"),
     # [thrust]
     "thrust": E("", "The thrust: a force of magnitude T (the load parameter) along the propulsor's own axis."),
     "thrust.point": E("m", "Point of application, body frame, from A.", "thrust point"),

@@ -240,6 +240,11 @@ class MountSpec(_Strict):
     damping: Optional[Damping6] = None
     rated_force: Optional[Positive] = None      # N, static force rating (isolation design)
     max_deflection: Optional[Positive] = None   # m, static deflection limit
+    # nonlinear mount law (axial-shear mounts only; see impstab.model.mount_law)
+    k3_axial: number("cubic_stiffness") = 0.0
+    k3_shear: number("cubic_stiffness") = 0.0
+    snubber_clearance: number("clearance") = 0.0
+    snubber_stiffness: number("stiffness") = 0.0
 
 
 class MountRingSpec(_Strict):
@@ -254,6 +259,11 @@ class MountRingSpec(_Strict):
     c_shear: Damping = 0.0
     rated_force: Optional[Positive] = None      # N, static force rating (isolation design)
     max_deflection: Optional[Positive] = None   # m, static deflection limit
+    # nonlinear mount law (see impstab.model.mount_law)
+    k3_axial: number("cubic_stiffness") = 0.0
+    k3_shear: number("cubic_stiffness") = 0.0
+    snubber_clearance: number("clearance") = 0.0
+    snubber_stiffness: number("stiffness") = 0.0
 
 
 class ThrustSpec(_Strict):

@@ -63,6 +63,9 @@ def _title(result) -> str:
         text = f"envelope: {g.envelope}"
         if g.envelope in ("exponential growth", "decaying") and math.isfinite(g.rate):
             text += f" at {number(g.rate, 4)} 1/s"
+        if g.envelope == "limit cycle" and g.amplitude:
+            unit = "m" if g.dof in ("surge", "sway", "heave") else "rad"
+            text += f", period {number(g.period, 4)} s, {g.dof} ±{number(g.amplitude[g.dof], 3)} {unit}"
         if g.linear_rate is not None:
             text += f"; max Re λ {growth(g.linear_rate, result.fastest_omega)} 1/s"
         lines.append(text)

@@ -177,6 +177,11 @@ def static_mount_loads(model: Model, thrust: float | None = None, linearization:
     if lin_kind == "equilibrium":
         lin = linearize(model, t, "equilibrium")
         e, load = static_loads_batch(pos, k, lin.displacement[None], rotation_vector(lin.rotation)[None], exact=True)
+        for i, m in enumerate(model.mounts):  # a nonlinear mount law adds grad V_nl(d) to the force
+            if m.is_nonlinear:
+                from ..model.mount_law import law_gradient
+
+                load[0, i, :3] += law_gradient(np.ascontiguousarray(m.nonlinear.packed()[None]), 0, *e[0, i, :3])
     else:
         pk = pack_model(model)
         stack = lambda a: np.asarray(a, dtype=float)[None]  # noqa: E731

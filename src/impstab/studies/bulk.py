@@ -15,7 +15,8 @@ or whose equilibrium would rotate under thrust (not affine), is handed back to t
 path, which gives it its exact status and message (:func:`impstab.model.model_from_dict`).
 
 Eligible: parameters among :data:`FIELDS` on a base model that is undamped, without propeller
-spin and without compressible fluid. Any other study takes the per-variant path.
+spin, without compressible fluid and without nonlinear mount laws (their equilibrium tangent is
+not affine in general). Any other study takes the per-variant path.
 """
 
 from __future__ import annotations
@@ -112,6 +113,8 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
     except Exception:  # noqa: BLE001 - the per-variant path reports it
         return None
     if model.is_damped or model.fluid.compressible or model.propeller.polar_inertia * model.propeller.speed != 0.0:
+        return None
+    if model.is_nonlinear:
         return None
     for seg in segments:
         if seg[0] == "mounts" and seg[2] in ("k_axial", "k_shear") and doc.mounts[seg[1]].stiffness is not None:
