@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 
 import impstab
-from impstab.linear.critical import _Engine
+from impstab.linear.engine import second_order_problem
 from impstab.linear.linearize import ModelFamily
 from impstab.model import model_from_dict
 from impstab.studies import load_study, run_study
@@ -83,9 +83,9 @@ def scan_operator_time(study, designs: np.ndarray, n_scan: int = 64) -> float:
         idx = np.unravel_index(j, study.shape)
         vals = [p.values[i] for p, i in zip(study.parameters, idx)]
         model = model_from_dict(variant_dict(study.base_model, [p.path.segments for p in study.parameters], vals))
-        eng = _Engine(ModelFamily(model), model.analysis.thrust_max)
+        problem = second_order_problem(ModelFamily(model), model.analysis.thrust_max)  # affine: A0 + T A1
         grid = np.linspace(0.0, model.analysis.thrust_max, n_scan + 1)
-        ops.append(eng.operators(grid)[0])
+        ops.append(problem.a0[None] + grid[:, None, None] * problem.a1[None])
     stack = np.ascontiguousarray(np.concatenate(ops))
     best = np.inf
     for _ in range(5):

@@ -1,0 +1,195 @@
+"""Problems of the engine: one-parameter operator families, built from second- and first-order systems.
+
+A :class:`Problem` is what the engine solves: the operator ``A(p)`` whose spectrum decides
+stability on ``[p_min, p_max]``, given as ``A0 + p A1`` (affine) or by a provider (any other
+family), and what the onset values need (the dofs of the mode, the participation weights).
+
+* a second-order family ``M q'' + (D + G) q' + K(p) q = 0`` without damping and gyroscopic terms
+  is an *undamped* problem: ``A = M^-1 K`` with eigenvalues ``s = omega^2`` (stable: all real and
+  positive), ``n`` states;
+* with damping or gyroscopic terms it is a first-order problem on ``x = (q, q')``:
+  ``A = [[0, I], [-M^-1 K, -M^-1 (D + G)]]``, ``2 n`` states, eigenvalues ``lambda`` (stable: all
+  ``Re lambda < 0``); the mode and the participation are those of ``q``;
+* a first-order family ``E x' = A(p) x`` is a first-order problem with ``A = E^-1 A(p)``; its
+  first ``n_dof`` states are the ones the mode and participation are reported for.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..eigen import state_matrices
+
+__all__ = ["Problem", "second_order_problem", "first_order_problem"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(eq=False)
+class Problem:
+    """One critical-load search.
+
+    Attributes
+    ----------
+    undamped : bool
+        Eigenvalues are ``s = omega^2`` of ``M^-1 K`` (True) or ``lambda`` of a first-order
+        operator (False).
+    p_min, p_max : float
+        Load range.
+    n_scan : int
+        Scan intervals on it.
+    order : int
+        Order ``N`` of the operator.
+    n_dof : int
+        Leading states in the reported mode and participation.
+    a0, a1 : (N, N) arrays or None
+        ``A = a0 + p a1`` for affine problems.
+    weights : (n_dof,) array
+        Participation weights (mass diagonal), for affine problems.
+    provider : object or None
+        For the others: ``operators(loads) -> (m, N, N)`` (NaN where no operator exists),
+        ``weights(p) -> (n_dof,)``, and ``fold_indicator(p) -> float`` (the square of the
+        smallest eigenvalue magnitude of the static problem, for limit points).
+    """
+
+    undamped: bool
+    p_min: float
+    p_max: float
+    n_scan: int
+    order: int
+    n_dof: int
+    a0: Array | None = None
+    a1: Array | None = None
+    weights: Array | None = None
+    provider: object | None = None
+    error: BaseException | None = field(default=None)
+
+    @property
+    def affine(self) -> bool:
+        return self.a0 is not None
+
+
+class _SecondOrderProvider:
+    """Operators of a second-order family that is not affine (``family.matrices`` per load)."""
+
+    def __init__(self, family, undamped: bool) -> None:
+        self.family = family
+        self.undamped = undamped
+        self.error: BaseException | None = None
+        self._mass: dict[float, Array] = {}
+
+    def operators(self, loads: Array) -> Array:
+        m, d, g, k = self.family.matrices(np.asarray(loads, dtype=float))
+        n = m.shape[-1]
+        size = n if self.undamped else 2 * n
+        out = np.full((len(loads), size, size), np.nan)
+        good = np.isfinite(m).all(axis=(1, 2)) & np.isfinite(k).all(axis=(1, 2)) & np.isfinite(d + g).all(axis=(1, 2))
+        if good.any():
+            if self.undamped:
+                out[good] = np.linalg.solve(m[good], k[good])
+            else:
+                out[good] = state_matrices(m[good], (d + g)[good], k[good])
+        for p, mm in zip(loads, m):
+            self._mass[float(p)] = np.diag(mm).copy()
+        if len(self._mass) > 4096:
+            self._mass.clear()
+        return out
+
+    def weights(self, p: float) -> Array:
+        hit = self._mass.get(float(p))
+        if hit is None:
+            hit = np.diag(self.family.matrices(np.array([p]))[0][0]).copy()
+        return hit
+
+    def fold_indicator(self, p: float) -> float:
+        m, _, _, k = self.family.matrices(np.array([p]))
+        if not np.isfinite(k).all():
+            return np.nan
+        s = np.linalg.eigvals(np.linalg.solve(m[0], k[0]))
+        return float(np.min(np.abs(s)) ** 2)
+
+
+class _FirstOrderProvider:
+    """Operators ``E^-1 A(p)`` of a first-order family that is not affine."""
+
+    def __init__(self, family) -> None:
+        self.family = family
+        self.error: BaseException | None = None
+        self._weights = np.asarray(getattr(family, "weights", None) if getattr(family, "weights", None) is not None
+                                   else np.ones(family.n_dof), dtype=float)
+
+    def operators(self, loads: Array) -> Array:
+        e, a = self.family.matrices(np.asarray(loads, dtype=float))
+        out = np.full(a.shape, np.nan)
+        good = np.isfinite(e).all(axis=(1, 2)) & np.isfinite(a).all(axis=(1, 2))
+        if good.any():
+            out[good] = np.linalg.solve(e[good], a[good])
+        return out
+
+    def weights(self, p: float) -> Array:
+        return self._weights
+
+    def fold_indicator(self, p: float) -> float:
+        op = self.operators(np.array([p]))[0]
+        if not np.isfinite(op).all():
+            return np.nan
+        return float(np.min(np.abs(np.linalg.eigvals(op))) ** 2)
+
+
+def _range(family, p_min: float, p_max: float, n_scan: int):
+    if not (np.isfinite(p_max) and np.isfinite(p_min) and p_max > p_min):
+        raise ValueError(f"p_max = {p_max!r}: must be finite and above p_min = {p_min!r}")
+    if int(n_scan) < 1:
+        raise ValueError(f"n_scan = {n_scan!r}: must be at least 1")
+    return float(p_min), float(p_max), int(n_scan)
+
+
+def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: int = 64,
+                         undamped: bool | None = None) -> Problem:
+    """The problem of a second-order family ``p -> (M, D, G, K)`` (:class:`~impstab.linear.SystemFamily`).
+
+    ``undamped`` forces the undamped (``s``) or the first-order form; by default the undamped form
+    is used where D and G vanish (affine families: exactly; others: at ``p_min``, the middle and
+    ``p_max``, since damping and gyroscopic terms may follow the load).
+    """
+    p_min, p_max, n_scan = _range(family, p_min, p_max, n_scan)
+    parts = family.affine_parts() if hasattr(family, "affine_parts") else None
+    if parts is not None:
+        d, g = parts[1], parts[2]
+    else:
+        _, d, g, _ = family.matrices(np.array([p_min, 0.5 * (p_min + p_max), p_max]))
+    if undamped is None:
+        undamped = not (np.any(d != 0) or np.any(g != 0))
+    n = int(family.n)
+    if parts is None:
+        return Problem(bool(undamped), p_min, p_max, n_scan, n if undamped else 2 * n, n,
+                       provider=_SecondOrderProvider(family, bool(undamped)))
+    m, d, g, k0, k1 = (np.asarray(x, dtype=float) for x in parts)
+    if undamped:
+        a = np.linalg.solve(m, np.concatenate([k0, k1], axis=1))
+        a0, a1 = a[:, :n], a[:, n:]
+    else:
+        a0 = state_matrices(m, d + g, k0)
+        a1 = np.zeros_like(a0)
+        a1[n:, :n] = -np.linalg.solve(m, k1)
+    return Problem(bool(undamped), p_min, p_max, n_scan, a0.shape[0], n, np.ascontiguousarray(a0),
+                   np.ascontiguousarray(a1), np.diag(m).copy())
+
+
+def first_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: int = 64) -> Problem:
+    """The problem of a first-order family ``E x' = A(p) x`` (:class:`~impstab.linear.FirstOrderFamily`)."""
+    p_min, p_max, n_scan = _range(family, p_min, p_max, n_scan)
+    n = int(family.n)
+    n_dof = int(getattr(family, "n_dof", n) or n)
+    parts = family.affine_parts() if hasattr(family, "affine_parts") else None
+    if parts is None:
+        return Problem(False, p_min, p_max, n_scan, n, n_dof, provider=_FirstOrderProvider(family))
+    e, a0, a1 = (np.asarray(x, dtype=float) for x in parts)
+    a = np.linalg.solve(e, np.concatenate([a0, a1], axis=1))
+    weights = getattr(family, "weights", None)
+    weights = np.ones(n_dof) if weights is None else np.asarray(weights, dtype=float)
+    return Problem(False, p_min, p_max, n_scan, n, n_dof, np.ascontiguousarray(a[:, :n]),
+                   np.ascontiguousarray(a[:, n:]), weights.copy())

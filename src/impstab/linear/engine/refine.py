@@ -1,0 +1,598 @@
+"""Exact refinement of every bracket (compiled), and the onset values there (THEORY 5).
+
+A bracket ``(a, b)`` has ``a`` stable and ``b`` unstable by the classification, whose thresholds
+only bracket. The onset itself is the root of a smooth indicator that crosses zero linearly:
+
+* the cluster going unstable at ``b`` (two eigenvalues, or four where two symmetric planes merge
+  at once) is followed across the bracket by its oblique spectral projector ``V_C W_C^H``
+  (``W^H = V^-1``), which picks the ``k`` eigenvectors at a load lying most in it;
+* undamped second-order problems (``s = omega^2``): ``Delta = k sum s_i^2 - (sum s_i)^2`` of the
+  cluster, a symmetric function analytic in the load although the double root is defective
+  (its eigenvalues carry sqrt(eps) noise, ``Delta`` only eps): positive while the cluster is real,
+  negative once it is a complex pair; divergence: the cluster mean of ``s``;
+* first-order problems (``lambda``): the largest real part of the cluster from its symmetric
+  functions (``Re c + |Re sqrt(d)|`` with the mean ``c`` and variance ``d`` of the upper half, a
+  Hopf crossing). A branch that lay on the imaginary axis before (an undamped gyroscopic
+  problem) leaves it like ``sqrt(p - p_c)``; there the onset is where it is off the axis by the
+  classification tolerance, an error of the order of that tolerance squared.
+
+Affine problems use the exact derivative of the indicator (eigenvalue derivatives
+``W_C A1 V_C``) in a bracketed Newton iteration; the others scipy's Brent method (``brentq``,
+ported as steps). Where the cluster at ``b`` is not clearly one at ``a``, the bracket is halved
+on the classification and tried again; where the indicator shows ``a`` already past the onset,
+``a`` steps back by the bracket width. Where the exact route cannot be used at all, the bracket
+is narrowed on the classification alone and the result carries a warning.
+"""
+
+from __future__ import annotations
+
+from math import sqrt
+
+import numpy as np
+from numba import njit
+
+from ..classify import _masks
+from ..participation import participation_into
+from .scan import _classify
+from .spectra import FAILED, NOT_FINITE, OK, PROVIDER_ERROR, cache_new, provided_weights, spectrum, workspace
+from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
+
+__all__ = ["refine_stack"]
+
+#: onset kinds; a limit point still to be located by the caller (its bracket is returned)
+FLUTTER, DIVERGENCE, LIMIT = 1, 2, 3
+_EPS4 = 4.0 * EPS
+
+
+# -- the cluster ------------------------------------------------------------------------------
+@njit(cache=True)
+def _relative_real(v):
+    mag = abs(v)
+    return v.real / mag if mag > 0 else 0.0
+
+
+@njit(cache=True)
+def unstable_cluster(vals, undamped, members, cplx, neg):
+    """The cluster that is unstable into the mask ``members``; returns ``(found, unique, divergence)``.
+
+    ``unique``: every unstable eigenvalue is in the cluster. ``cplx, neg`` are ``(1, n)`` work arrays.
+    """
+    n = vals.shape[0]
+    _masks(vals.reshape(1, n), undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR, cplx, neg)
+    j0 = -1
+    divergence = False
+    if undamped:
+        for i in range(n):
+            if cplx[0, i] and (j0 < 0 or vals[i].real < vals[j0].real):
+                j0 = i
+        if j0 < 0:
+            divergence = True
+            for i in range(n):
+                if neg[0, i] and (j0 < 0 or vals[i].real < vals[j0].real):
+                    j0 = i
+    else:
+        best = -np.inf
+        for i in range(n):
+            if cplx[0, i] or neg[0, i]:
+                r = _relative_real(vals[i])
+                if j0 < 0 or r > best:
+                    j0, best = i, r
+        if j0 >= 0:
+            divergence = neg[0, j0]
+    if j0 < 0:
+        members[:] = True
+        return False, False, False
+    ref = vals[j0]
+    big = 0.0
+    for v in vals:
+        big = max(big, abs(v))
+    tol = max(TOL_CLUSTER * abs(ref), FLOOR * big)
+    unique = True
+    for i in range(n):
+        v = vals[i]
+        close = abs(v - ref) <= tol or abs(v - ref.conjugate()) <= tol
+        if not undamped and not divergence:
+            # the decaying partner of a merged pair has the same frequency: keep it in the
+            # cluster (before the merge the two modes span both branches)
+            close = close or abs(abs(v.imag) - abs(ref.imag)) <= tol
+        members[i] = close
+        if (cplx[0, i] or neg[0, i]) and not close:
+            unique = False
+    return True, unique, divergence
+
+
+@njit(cache=True)
+def projector(vecs, inv, members, vc, wc):
+    """The cluster's oblique projector ``V_C W_C^H`` as ``vc (n, k)``, ``wc (k, n)``; returns ``k``."""
+    n = vecs.shape[0]
+    k = 0
+    for c in range(n):
+        if members[c]:
+            for r in range(n):
+                vc[r, k] = vecs[r, c]
+                wc[k, r] = inv[c, r]
+            k += 1
+    return k
+
+
+@njit(cache=True)
+def select(vecs, vc, wc, k, sel, share):
+    """The ``k`` eigenvectors lying most in the cluster subspace into ``sel[:k]``; whether clear.
+
+    ``vecs`` are unit columns; the share of each is the squared norm of its oblique projection
+    onto the cluster subspace; clear when the ``k``-th share exceeds 1/4 and the next is below.
+    """
+    n = vecs.shape[0]
+    t = np.empty(k, dtype=np.complex128)
+    for c in range(n):
+        for i in range(k):
+            s = 0j
+            for r in range(n):
+                s += wc[i, r] * vecs[r, c]
+            t[i] = s
+        total = 0.0
+        for r in range(n):
+            y = 0j
+            for i in range(k):
+                y += vc[r, i] * t[i]
+            total += y.real * y.real + y.imag * y.imag
+        share[c] = total
+    order = np.argsort(-share[:n], kind="mergesort")
+    for i in range(k):
+        sel[i] = order[i]
+    return share[order[k - 1]] > 0.25 and (n == k or share[order[k]] < 0.25)
+
+
+@njit(cache=True)
+def _pair_growth(v, k):
+    """Largest real part of a cluster (upper half plane), from its symmetric functions.
+
+    For the upper-half members (a pair, possibly each doubled by symmetry) ``c = mean`` and
+    ``d = mean((lambda - c)^2)`` are analytic in the load even where the pair is defective, so
+    ``Re c + |Re sqrt(d)|`` keeps its accuracy there; for a single eigenvalue it is ``Re lambda``.
+    """
+    upper = False
+    for i in range(k):
+        upper = upper or v[i].imag > 0
+    c = 0j
+    m = 0
+    for i in range(k):
+        if not upper or v[i].imag >= 0:
+            c += v[i]
+            m += 1
+    c /= m
+    d = 0j
+    for i in range(k):
+        if not upper or v[i].imag >= 0:
+            d += (v[i] - c) ** 2
+    d /= m
+    return c.real + abs(np.sqrt(d).real)
+
+
+@njit(cache=True)
+def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, derivative, sel, share):
+    """``(f, df, clear)``: the exact indicator of the cluster in the decomposition, its derivative.
+
+    ``df`` (affine problems, ``derivative``) from the eigenvalue derivatives ``W_C A1 V_C``;
+    ``clear`` False where the cluster is not found clearly (then the values mean nothing).
+    """
+    if not select(vecs, vc, wc, k, sel, share):
+        return 0.0, 0.0, False
+    v = np.empty(k, dtype=np.complex128)
+    for i in range(k):
+        v[i] = vals[sel[i]]
+    jj = 0
+    if undamped:
+        s1 = 0j
+        s2 = 0j
+        for i in range(k):
+            s1 += v[i]
+            s2 += v[i] * v[i]
+        f = s1.real / k if divergence else (k * s2 - s1 * s1).real
+    else:
+        best = -np.inf
+        for i in range(k):
+            r = _relative_real(v[i])
+            if r > best:
+                jj, best = i, r
+        f = _pair_growth(v, k) - target * abs(v[jj])
+    if not derivative:
+        return f, 0.0, True
+    n = vecs.shape[0]
+    b = np.empty(k, dtype=np.complex128)
+    for i in range(k):
+        c0 = sel[i]
+        acc = 0j
+        for r in range(n):
+            w = inv[c0, r]
+            if w == 0:
+                continue
+            row = 0j
+            for c in range(n):
+                row += a1[r, c] * vecs[c, c0]
+            acc += w * row
+        b[i] = acc
+    if not undamped:
+        return f, b[jj].real, True
+    if divergence:
+        df = 0.0
+        for i in range(k):
+            df += b[i].real
+        return f, df / k, True
+    s1 = 0j
+    sb = 0j
+    svb = 0j
+    for i in range(k):
+        s1 += v[i]
+        sb += b[i]
+        svb += v[i] * b[i]
+    return f, (2 * k * svb - 2 * s1 * sb).real, True
+
+
+# -- roots, as steps (reverse communication) ------------------------------------------------------
+@njit(cache=True)
+def newton_step(st, p, f, df):
+    """Bracketed Newton (bisection guard) after ``f, df`` at ``p``; returns ``(next, done)``.
+
+    ``st = (lo, hi, f_lo)``: the bracket, updated here.
+    """
+    if f == 0.0:
+        return p, True
+    if np.sign(f) == np.sign(st[2]):
+        st[0], st[2] = p, f
+    else:
+        st[1] = p
+    lo, hi = st[0], st[1]
+    new = p - f / df if df != 0.0 else np.inf
+    if not (min(lo, hi) < new < max(lo, hi)):
+        new = 0.5 * (lo + hi)
+    return new, abs(new - p) <= _EPS4 * abs(p) or new == lo or new == hi
+
+
+@njit(cache=True)
+def brent_step(st, f):
+    """scipy's ``brentq`` (xtol 1e-300, rtol 4 eps) as steps; returns ``(x, done)``.
+
+    ``st = (xpre, xcur, xblk, fpre, fcur, fblk, spre, scur)``; ``f`` is the value at the last
+    point returned (NaN on the first call, which starts from ``xpre, xcur, fpre, fcur``).
+    """
+    xtol, rtol = 1e-300, _EPS4
+    xpre, xcur, xblk, fpre, fcur, fblk, spre, scur = st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]
+    if not np.isnan(f):
+        fcur = f
+    if fpre != 0 and fcur != 0 and (np.signbit(fpre) != np.signbit(fcur)):
+        xblk, fblk = xpre, fpre
+        spre = scur = xcur - xpre
+    if abs(fblk) < abs(fcur):
+        xpre, xcur, xblk = xcur, xblk, xcur
+        fpre, fcur, fblk = fcur, fblk, fcur
+    delta = (xtol + rtol * abs(xcur)) / 2
+    sbis = (xblk - xcur) / 2
+    done = fcur == 0 or abs(sbis) < delta
+    if not done:
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:  # interpolate
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:  # extrapolate
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2 * abs(stry) < min(abs(spre), 3 * abs(sbis) - delta):
+                spre, scur = scur, stry
+            else:
+                spre, scur = sbis, sbis
+        else:
+            spre, scur = sbis, sbis
+        xpre, fpre = xcur, fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0 else -delta
+    st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7] = xpre, xcur, xblk, fpre, fcur, fblk, spre, scur
+    return xcur, done
+
+
+# -- onset values -------------------------------------------------------------------------------
+@njit(cache=True)
+def onset_values(vals, vecs, members, k, undamped, divergence, shapes, values, weights, mode, part):
+    """Kind and omega of the onset, its mode (largest component 1) and participation.
+
+    ``vals, vecs``: the decomposition at the onset, ``members[:k]`` the cluster's columns;
+    ``shapes (n, k), values (k,)``: the distinct modes the participation is taken from.
+    """
+    n = mode.shape[0]
+    lead = members[0]
+    if undamped:
+        omega = 0.0
+        if not divergence:
+            mean = 0.0
+            for i in range(k):
+                mean += vals[members[i]].real
+                if abs(vals[members[i]].imag) > abs(vals[lead].imag):
+                    lead = members[i]
+            omega = sqrt(max(mean / k, 0.0))
+    else:
+        for i in range(k):
+            if vals[members[i]].real > vals[lead].real:
+                lead = members[i]
+        omega = 0.0 if divergence else abs(vals[lead].imag)
+    big = 0
+    for r in range(n):
+        mode[r] = vecs[r, lead]
+        if abs(mode[r]) > abs(mode[big]):
+            big = r
+    scale = mode[big].conjugate() / (abs(mode[big]) ** 2)
+    for r in range(n):
+        mode[r] *= scale
+    # each distinct mode of the cluster weighs equally in the participation
+    participation_into(shapes, values, np.ones(k, dtype=np.bool_), weights, TOL_DUPLICATE, part)
+    return (DIVERGENCE if divergence else FLUTTER), omega
+
+
+@njit(cache=True)
+def _take(vals, vecs, cols, k, n):
+    """``(vecs[:n, cols[:k]], vals[cols[:k]])``, new arrays."""
+    shapes = np.empty((n, k), dtype=np.complex128)
+    values = np.empty(k, dtype=np.complex128)
+    for i in range(k):
+        values[i] = vals[cols[i]]
+        for r in range(n):
+            shapes[r, i] = vecs[r, cols[i]]
+    return shapes, values
+
+
+# -- every bracket of every problem ---------------------------------------------------------------
+@njit(cache=True)
+def refine_stack(jobs, brk, count, start_unstable, status, out):
+    """Refine every bracket of every problem; the onsets and the first loss into ``out``.
+
+    ``out``: per bracket ``load, kind, omega, direction, warned`` (and ``limit``: the bracket of a
+    limit point, kind :data:`LIMIT`), per problem ``first`` (the first loss, -1: none), its
+    ``mode`` and ``part``, ``evaluations`` and ``bisections``; ``status[j]`` becomes 1 where the
+    provider failed. A problem unstable at the start gets its onset values there in row 0.
+    """
+    n = jobs.a0.shape[1]
+    n_dof = out.mode.shape[1]
+    ws = workspace(n, 1)
+    cache = cache_new(n)
+    vc = np.empty((n, n), dtype=np.complex128)
+    wc = np.empty((n, n), dtype=np.complex128)
+    sel = np.empty(n, dtype=np.int64)
+    cols = np.empty(n, dtype=np.int64)
+    share = np.empty(n)
+    members = np.empty(n, dtype=np.bool_)
+    cplx = np.empty((1, n), dtype=np.bool_)
+    neg = np.empty((1, n), dtype=np.bool_)
+    one_flag = np.zeros(1, dtype=np.bool_)
+    one_ind = np.zeros((1, 2))
+    weights = np.empty(n_dof)
+    mode = np.empty(n_dof, dtype=np.complex128)
+    part = np.empty(n_dof)
+    point = np.zeros(1)
+    st = np.zeros(8)
+    ev = np.zeros(1, dtype=np.int64)
+    for j in range(len(jobs.form)):
+        if status[j] != 0:
+            continue
+        cache[0][:] = np.nan
+        ev[0] = 0
+        undamped = jobs.form[j] == 0
+        affine = jobs.affine[j]
+        lo_lim, hi_lim = jobs.p_lo[j], jobs.p_hi[j]
+        a1 = jobs.a1[j]
+        failed = False
+        first = -1
+        tasks = 1 if start_unstable[j] else count[j]
+        for t in range(tasks):
+            if start_unstable[j]:
+                a, b = np.nan, jobs.grids[j, 0]
+            else:
+                a, b = brk[j, t, 0], brk[j, t, 1]
+            out.direction[j, t] = 1 if not a > b else -1
+            root = np.nan
+            warned = False
+            limit = False
+            divergence = False
+            k = 0
+            shapes = np.empty((n_dof, 1), dtype=np.complex128)
+            values = np.empty(1, dtype=np.complex128)
+            vals_r = np.empty(n, dtype=np.complex128)
+            vecs_r = np.empty((n, n), dtype=np.complex128)
+            steps = 0 if start_unstable[j] else 200
+            for _ in range(steps):
+                point[0] = b
+                code_b, sb = spectrum(jobs, j, point, True, cache, ws, ev)
+                if code_b == PROVIDER_ERROR:
+                    failed = True
+                    break
+                if code_b == NOT_FINITE:
+                    # no static equilibrium at b: close in on the limit point
+                    mid = 0.5 * (a + b)
+                    if mid == a or mid == b:
+                        limit = True
+                        break
+                    point[0] = mid
+                    if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
+                        failed = True
+                        break
+                    _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
+                    if one_flag[0]:
+                        b = mid
+                    else:
+                        a = mid
+                    continue
+                found, unique, divergence = unstable_cluster(cache[2][sb], undamped, members, cplx, neg)
+                step_back = False
+                if found and code_b == OK:
+                    k = projector(cache[3][sb], cache[4][sb], members, vc, wc)
+                    point[0] = a
+                    code_a, sa = spectrum(jobs, j, point, True, cache, ws, ev)
+                    if code_a == PROVIDER_ERROR:
+                        failed = True
+                        break
+                    ok_a = code_a != NOT_FINITE and select(cache[3][sa], vc, wc, k, sel, share)
+                    while unique and ok_a:  # the exact route (a loop only to leave it early)
+                        target = 0.0
+                        if not undamped:
+                            # on the imaginary axis (to rounding) at a and a step before it? Then the
+                            # branch leaves like sqrt(p - p_c), and the onset is where it is off the
+                            # axis by TOL_UNSTABLE
+                            marginal = True
+                            for p in (a, min(max(a + (a - b), lo_lim), hi_lim)):
+                                point[0] = p
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                if code == PROVIDER_ERROR:
+                                    failed = True
+                                    break
+                                if code == NOT_FINITE or not select(cache[3][s], vc, wc, k, sel, share):
+                                    marginal = False
+                                    break
+                                for i in range(k):
+                                    if abs(_relative_real(cache[2][s][sel[i]])) > TOL_MARGINAL:
+                                        marginal = False
+                                if not marginal:
+                                    break
+                            if failed:
+                                break
+                            if marginal:
+                                target = TOL_UNSTABLE
+                        fab = np.zeros(2)
+                        clear = True
+                        for e in range(2):
+                            point[0] = a if e == 0 else b
+                            code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                            if code == PROVIDER_ERROR:
+                                failed = True
+                                break
+                            f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
+                                                 divergence, target, False, sel, share)
+                            clear = clear and code != NOT_FINITE and ok
+                            fab[e] = f
+                        if failed or not clear:
+                            break
+                        fa, fb = fab[0], fab[1]
+                        if fa == 0.0:
+                            root = a
+                        elif np.sign(fa) == np.sign(fb):
+                            step_back = True
+                            break
+                        elif affine and target == 0.0 and (undamped or k <= 2):
+                            st[0], st[1], st[2] = a, b, fa
+                            p = a - fa * (b - a) / (fb - fa)
+                            for _ in range(100):
+                                point[0] = p
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                if code == PROVIDER_ERROR:
+                                    failed = True
+                                    break
+                                if code != OK:
+                                    break
+                                f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc,
+                                                      k, divergence, 0.0, True, sel, share)
+                                if not ok:
+                                    break
+                                p, done = newton_step(st, p, f, df)
+                                if done:
+                                    root = p
+                                    break
+                        else:
+                            st[0], st[1], st[3], st[4] = a, b, fa, fb
+                            st[2] = st[5] = st[6] = st[7] = 0.0
+                            f = np.nan
+                            for _ in range(200):
+                                x, done = brent_step(st, f)
+                                if done:
+                                    root = x
+                                    break
+                                point[0] = x
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                if code == PROVIDER_ERROR:
+                                    failed = True
+                                    break
+                                f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
+                                                     divergence, target, False, sel, share)
+                                if code == NOT_FINITE or not ok:
+                                    break
+                        break
+                    if failed:
+                        break
+                    if not np.isnan(root):
+                        # the onset values: cluster at the root, distinct modes at a (stable side)
+                        point[0] = root
+                        code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                        if code == PROVIDER_ERROR:
+                            failed = True
+                            break
+                        select(cache[3][s], vc, wc, k, sel, share)
+                        cols[:k] = sel[:k]
+                        shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
+                        vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
+                        point[0] = a
+                        code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                        if code == PROVIDER_ERROR:
+                            failed = True
+                            break
+                        if code != NOT_FINITE and select(cache[3][s], vc, wc, k, sel, share):
+                            shapes, values = _take(cache[2][s], cache[3][s], sel, k, n_dof)
+                        break
+                    if step_back:
+                        new_a = min(max(a + (a - b), lo_lim), hi_lim)
+                        if new_a == a:
+                            break
+                        a = new_a
+                        continue
+                mid = 0.5 * (a + b)
+                if mid == a or mid == b:
+                    break
+                point[0] = mid
+                if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
+                    failed = True
+                    break
+                _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
+                out.bisections[j] += 1
+                if one_flag[0]:
+                    b = mid
+                else:
+                    a = mid
+            if failed:
+                break
+            if limit:
+                out.kind[j, t] = LIMIT
+                out.load[j, t] = b
+                out.limit[j, t, 0], out.limit[j, t, 1] = a, b
+                continue
+            if np.isnan(root):
+                # the exact indicator could not be used (or the problem is unstable at the start):
+                # the onset values at b, from its unstable cluster
+                warned = not start_unstable[j]
+                root = b
+                point[0] = b
+                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                if code == PROVIDER_ERROR:
+                    failed = True
+                    break
+                found, _, divergence = unstable_cluster(cache[2][s], undamped, members, cplx, neg)
+                k = 0
+                for i in range(n):
+                    if members[i]:
+                        cols[k] = i
+                        k += 1
+                shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
+                vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
+            if jobs.affine[j] or jobs.key[j] < 0:
+                weights[:] = jobs.weights[j]
+            elif provided_weights(jobs.key[j], root, weights) != 0:
+                failed = True
+                break
+            kind, omega = onset_values(vals_r, vecs_r, cols, k, undamped, divergence, shapes, values, weights, mode,
+                                       part)
+            out.load[j, t], out.kind[j, t], out.omega[j, t], out.warned[j, t] = root, kind, omega, warned
+            if start_unstable[j] or (a < b and (first < 0 or root < out.load[j, first])):
+                first = t
+                out.mode[j, :] = mode
+                out.part[j, :] = part
+        out.evaluations[j] += ev[0]
+        if failed:
+            status[j] = 1
+            continue
+        out.first[j] = first
