@@ -43,7 +43,7 @@ def _square(name: str, a: object, n: int | None = None) -> Array:
     arr = np.asarray(a, dtype=float)
     if arr.ndim != 2 or arr.shape[0] != arr.shape[1] or (n is not None and arr.shape[0] != n):
         raise ValueError(f"{name} must be a square {n or 'n'} x {n or 'n'} matrix, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
+    if not np.isfinite(arr).all():
         raise ValueError(f"{name} has non-finite entries")
     return arr
 

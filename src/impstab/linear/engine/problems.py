@@ -16,12 +16,13 @@ family), and what the onset values need (the dofs of the mode, the participation
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..eigen import state_matrices
+from .large import LARGE_ORDER
 
 __all__ = ["Problem", "second_order_problem", "first_order_problem"]
 
@@ -49,6 +50,9 @@ class Problem:
         ``A = a0 + p a1`` for affine problems.
     weights : (n_dof,) array
         Participation weights (mass diagonal), for affine problems.
+    second_order : tuple of arrays or None
+        ``(M, K0, K1)`` of an affine undamped second-order problem (for the reduction of large
+        ones, :mod:`impstab.linear.engine.large`).
     provider : object or None
         For the others: ``operators(loads) -> (m, N, N)`` (NaN where no operator exists),
         ``weights(p) -> (n_dof,)``, and ``fold_indicator(p) -> float`` (the square of the
@@ -65,11 +69,18 @@ class Problem:
     a1: Array | None = None
     weights: Array | None = None
     provider: object | None = None
-    error: BaseException | None = field(default=None)
+    second_order: tuple | None = None
 
     @property
     def affine(self) -> bool:
-        return self.a0 is not None
+        return self.a0 is not None or self.second_order is not None
+
+    def operators(self) -> tuple[Array, Array]:
+        """``(a0, a1)`` of an affine problem (formed from ``second_order`` when first needed)."""
+        if self.a0 is None:
+            m, k0, k1 = self.second_order
+            self.a0, self.a1 = np.linalg.solve(m, np.stack([k0, k1]))
+        return self.a0, self.a1
 
 
 class _SecondOrderProvider:
@@ -158,25 +169,27 @@ def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: in
     p_min, p_max, n_scan = _range(family, p_min, p_max, n_scan)
     parts = family.affine_parts() if hasattr(family, "affine_parts") else None
     if parts is not None:
+        parts = tuple(np.asarray(x, dtype=float) for x in parts)
         d, g = parts[1], parts[2]
     else:
         _, d, g, _ = family.matrices(np.array([p_min, 0.5 * (p_min + p_max), p_max]))
     if undamped is None:
-        undamped = not (np.any(d != 0) or np.any(g != 0))
+        undamped = not (d.any() or g.any())
     n = int(family.n)
     if parts is None:
         return Problem(bool(undamped), p_min, p_max, n_scan, n if undamped else 2 * n, n,
                        provider=_SecondOrderProvider(family, bool(undamped)))
-    m, d, g, k0, k1 = (np.asarray(x, dtype=float) for x in parts)
+    m, d, g, k0, k1 = parts
     if undamped:
-        a = np.linalg.solve(m, np.concatenate([k0, k1], axis=1))
-        a0, a1 = a[:, :n], a[:, n:]
+        problem = Problem(True, p_min, p_max, n_scan, n, n, weights=np.diag(m).copy(), second_order=(m, k0, k1))
+        if n <= LARGE_ORDER:  # a large one may be reduced: its operators are formed only if needed
+            problem.operators()
+        return problem
     else:
         a0 = state_matrices(m, d + g, k0)
         a1 = np.zeros_like(a0)
         a1[n:, :n] = -np.linalg.solve(m, k1)
-    return Problem(bool(undamped), p_min, p_max, n_scan, a0.shape[0], n, np.ascontiguousarray(a0),
-                   np.ascontiguousarray(a1), np.diag(m).copy())
+    return Problem(False, p_min, p_max, n_scan, a0.shape[0], n, a0, a1, np.diag(m).copy())
 
 
 def first_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: int = 64) -> Problem:
@@ -188,8 +201,7 @@ def first_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: int
     if parts is None:
         return Problem(False, p_min, p_max, n_scan, n, n_dof, provider=_FirstOrderProvider(family))
     e, a0, a1 = (np.asarray(x, dtype=float) for x in parts)
-    a = np.linalg.solve(e, np.concatenate([a0, a1], axis=1))
+    a0, a1 = np.linalg.solve(e, np.stack([a0, a1]))
     weights = getattr(family, "weights", None)
     weights = np.ones(n_dof) if weights is None else np.asarray(weights, dtype=float)
-    return Problem(False, p_min, p_max, n_scan, n, n_dof, np.ascontiguousarray(a[:, :n]),
-                   np.ascontiguousarray(a[:, n:]), weights.copy())
+    return Problem(False, p_min, p_max, n_scan, n, n_dof, a0, a1, weights.copy())

@@ -33,6 +33,8 @@ from numba import njit
 
 from ..classify import _masks
 from ..participation import participation_into
+from .layout import (AFFINE, BISECTIONS, BRACKETS, DIRECTION, EVALUATIONS, FIRST, FORM, HI, KEY, KIND, LO, LOAD,
+                     OMEGA, START_UNSTABLE, STATUS, WARNED)
 from .scan import _classify
 from .spectra import FAILED, NOT_FINITE, OK, PROVIDER_ERROR, cache_new, provided_weights, spectrum, workspace
 from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
@@ -234,7 +236,11 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
 def newton_step(st, p, f, df):
     """Bracketed Newton (bisection guard) after ``f, df`` at ``p``; returns ``(next, done)``.
 
-    ``st = (lo, hi, f_lo)``: the bracket, updated here.
+    ``st = (lo, hi, f_lo, last Newton step or NaN)``: the bracket, updated here. Done when the
+    step is below 4 eps, or lands on an end of the bracket, or when the convergence seen so far
+    is clearly quadratic (the step shrank by 1e4 at least) and predicts the error of the next
+    point below eps: the error after a step ``d`` is ``C d^2``, ``C`` measured as
+    ``|d| / d_prev^2`` from the last two steps. (The indicators cross zero linearly: simple roots.)
     """
     if f == 0.0:
         return p, True
@@ -244,9 +250,16 @@ def newton_step(st, p, f, df):
         st[1] = p
     lo, hi = st[0], st[1]
     new = p - f / df if df != 0.0 else np.inf
+    prev = st[3]
+    st[3] = new - p
     if not (min(lo, hi) < new < max(lo, hi)):
         new = 0.5 * (lo + hi)
-    return new, abs(new - p) <= _EPS4 * abs(p) or new == lo or new == hi
+        st[3] = np.nan
+    step = abs(new - p)
+    if step <= _EPS4 * abs(p) or new == lo or new == hi:
+        return new, True
+    quadratic = not np.isnan(prev) and not np.isnan(st[3]) and step <= 1e-4 * abs(prev)
+    return new, quadratic and (step / (prev * prev)) * step * step <= EPS * abs(new)
 
 
 @njit(cache=True)
@@ -343,16 +356,15 @@ def _take(vals, vecs, cols, k, n):
 
 # -- every bracket of every problem ---------------------------------------------------------------
 @njit(cache=True)
-def refine_stack(jobs, brk, count, start_unstable, status, out):
-    """Refine every bracket of every problem; the onsets and the first loss into ``out``.
+def refine_stack(jobs, onsets, mode_out, part_out, counts):
+    """Refine every bracket of every problem: the onsets into ``onsets``, the first loss's mode
+    and participation into ``mode_out``, ``part_out`` (:mod:`impstab.linear.engine.layout`).
 
-    ``out``: per bracket ``load, kind, omega, direction, warned`` (and ``limit``: the bracket of a
-    limit point, kind :data:`LIMIT`), per problem ``first`` (the first loss, -1: none), its
-    ``mode`` and ``part``, ``evaluations`` and ``bisections``; ``status[j]`` becomes 1 where the
-    provider failed. A problem unstable at the start gets its onset values there in row 0.
+    A limit point gets kind :data:`LIMIT` and its final bracket in ``LO, HI``, for the caller to
+    locate. A problem unstable at the start gets its onset values there in row 0.
     """
     n = jobs.a0.shape[1]
-    n_dof = out.mode.shape[1]
+    n_dof = mode_out.shape[1]
     ws = workspace(n, 1)
     cache = cache_new(n)
     vc = np.empty((n, n), dtype=np.complex128)
@@ -371,24 +383,25 @@ def refine_stack(jobs, brk, count, start_unstable, status, out):
     point = np.zeros(1)
     st = np.zeros(8)
     ev = np.zeros(1, dtype=np.int64)
-    for j in range(len(jobs.form)):
-        if status[j] != 0:
+    for j in range(len(jobs.ints)):
+        if counts[j, STATUS] != 0:
             continue
         cache[0][:] = np.nan
         ev[0] = 0
-        undamped = jobs.form[j] == 0
-        affine = jobs.affine[j]
-        lo_lim, hi_lim = jobs.p_lo[j], jobs.p_hi[j]
+        undamped = jobs.ints[j, FORM] == 0
+        affine = jobs.ints[j, AFFINE] == 1
+        start_unstable = counts[j, START_UNSTABLE] == 1
+        lo_lim, hi_lim = jobs.span[j, 0], jobs.span[j, 1]
         a1 = jobs.a1[j]
         failed = False
         first = -1
-        tasks = 1 if start_unstable[j] else count[j]
+        tasks = 1 if start_unstable else counts[j, BRACKETS]
         for t in range(tasks):
-            if start_unstable[j]:
+            if start_unstable:
                 a, b = np.nan, jobs.grids[j, 0]
             else:
-                a, b = brk[j, t, 0], brk[j, t, 1]
-            out.direction[j, t] = 1 if not a > b else -1
+                a, b = onsets[j, t, LO], onsets[j, t, HI]
+            onsets[j, t, DIRECTION] = 1.0 if not a > b else -1.0
             root = np.nan
             warned = False
             limit = False
@@ -398,7 +411,8 @@ def refine_stack(jobs, brk, count, start_unstable, status, out):
             values = np.empty(1, dtype=np.complex128)
             vals_r = np.empty(n, dtype=np.complex128)
             vecs_r = np.empty((n, n), dtype=np.complex128)
-            steps = 0 if start_unstable[j] else 200
+            last = np.nan
+            steps = 0 if start_unstable else 200
             for _ in range(steps):
                 point[0] = b
                 code_b, sb = spectrum(jobs, j, point, True, cache, ws, ev)
@@ -477,10 +491,10 @@ def refine_stack(jobs, brk, count, start_unstable, status, out):
                             step_back = True
                             break
                         elif affine and target == 0.0 and (undamped or k <= 2):
-                            st[0], st[1], st[2] = a, b, fa
+                            st[0], st[1], st[2], st[3] = a, b, fa, np.nan
                             p = a - fa * (b - a) / (fb - fa)
                             for _ in range(100):
-                                point[0] = p
+                                point[0] = last = p
                                 code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                                 if code == PROVIDER_ERROR:
                                     failed = True
@@ -504,7 +518,7 @@ def refine_stack(jobs, brk, count, start_unstable, status, out):
                                 if done:
                                     root = x
                                     break
-                                point[0] = x
+                                point[0] = last = x
                                 code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                                 if code == PROVIDER_ERROR:
                                     failed = True
@@ -517,8 +531,9 @@ def refine_stack(jobs, brk, count, start_unstable, status, out):
                     if failed:
                         break
                     if not np.isnan(root):
-                        # the onset values: cluster at the root, distinct modes at a (stable side)
-                        point[0] = root
+                        # the onset values: cluster at the root (or at the last point evaluated, where
+                        # that is within 1e-12 of it), distinct modes at a (stable side)
+                        point[0] = last if abs(root - last) <= 1e-12 * abs(root) else root
                         code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                         if code == PROVIDER_ERROR:
                             failed = True
@@ -549,7 +564,7 @@ def refine_stack(jobs, brk, count, start_unstable, status, out):
                     failed = True
                     break
                 _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
-                out.bisections[j] += 1
+                counts[j, BISECTIONS] += 1
                 if one_flag[0]:
                     b = mid
                 else:
@@ -557,14 +572,13 @@ def refine_stack(jobs, brk, count, start_unstable, status, out):
             if failed:
                 break
             if limit:
-                out.kind[j, t] = LIMIT
-                out.load[j, t] = b
-                out.limit[j, t, 0], out.limit[j, t, 1] = a, b
+                onsets[j, t, KIND], onsets[j, t, LOAD] = LIMIT, b
+                onsets[j, t, LO], onsets[j, t, HI] = a, b
                 continue
             if np.isnan(root):
                 # the exact indicator could not be used (or the problem is unstable at the start):
                 # the onset values at b, from its unstable cluster
-                warned = not start_unstable[j]
+                warned = not start_unstable
                 root = b
                 point[0] = b
                 code, s = spectrum(jobs, j, point, True, cache, ws, ev)
@@ -579,20 +593,20 @@ def refine_stack(jobs, brk, count, start_unstable, status, out):
                         k += 1
                 shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
                 vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
-            if jobs.affine[j] or jobs.key[j] < 0:
+            if affine or jobs.ints[j, KEY] < 0:
                 weights[:] = jobs.weights[j]
-            elif provided_weights(jobs.key[j], root, weights) != 0:
+            elif provided_weights(jobs.ints[j, KEY], root, weights) != 0:
                 failed = True
                 break
             kind, omega = onset_values(vals_r, vecs_r, cols, k, undamped, divergence, shapes, values, weights, mode,
                                        part)
-            out.load[j, t], out.kind[j, t], out.omega[j, t], out.warned[j, t] = root, kind, omega, warned
-            if start_unstable[j] or (a < b and (first < 0 or root < out.load[j, first])):
+            onsets[j, t, LOAD], onsets[j, t, KIND], onsets[j, t, OMEGA] = root, kind, omega
+            onsets[j, t, WARNED] = 1.0 if warned else 0.0
+            if start_unstable or (a < b and (first < 0 or root < onsets[j, first, LOAD])):
                 first = t
-                out.mode[j, :] = mode
-                out.part[j, :] = part
-        out.evaluations[j] += ev[0]
+                mode_out[j, :] = mode
+                part_out[j, :] = part
+        counts[j, EVALUATIONS] += ev[0]
+        counts[j, FIRST] = first
         if failed:
-            status[j] = 1
-            continue
-        out.first[j] = first
+            counts[j, STATUS] = 1

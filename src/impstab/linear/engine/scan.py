@@ -24,6 +24,8 @@ import numpy as np
 from numba import njit, objmode
 
 from ..classify import _indicators, _masks
+from ..small_eigvec import _eigvector
+from .layout import BRACKETS, CHUNK, EVALUATIONS, FORM, HI, LO, N_SCAN, START_UNSTABLE, STATUS
 from .spectra import OK, PROVIDER_ERROR, cache_new, operators_at, spectrum, workspace
 from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_UNSTABLE
 
@@ -153,13 +155,10 @@ def _complex_eigvals(a, out):
 
 
 @njit(cache=True)
-def attraction(vals, vecs, inv, rate):
-    """Whether the closest pair of real ``s`` (decomposition ``vals, vecs, inv``) can merge.
+def closest_pair(vals, lower, upper):
+    """The closest pair of distinct real ``s`` as masks ``lower``, ``upper`` (their duplicates in).
 
-    Two nearby eigenvalues interact, to first order in the load, through the entries ``B_lu``,
-    ``B_ul`` of ``rate = dA/dp`` in the biorthogonal eigenbasis; ``B_lu B_ul < 0`` pulls them
-    together (a possible bubble), ``> 0`` makes them veer apart, zero (to rounding) means they do
-    not interact. Already complex: True; no distinct pair: False.
+    Returns 1 (found), 0 (no distinct pair: nothing to merge) or -1 (already complex).
     """
     n = vals.shape[0]
     big = 0.0
@@ -168,7 +167,7 @@ def attraction(vals, vecs, inv, rate):
         big = max(big, abs(v))
         worst = max(worst, abs(v.imag))
     if worst > TOL_UNSTABLE * big:
-        return True
+        return -1
     re = np.sort(vals.real)
     scale = 0.0
     for x in re:
@@ -181,13 +180,39 @@ def attraction(vals, vecs, inv, rate):
             gap = d
             jj = i
     if jj < 0:
-        return False
-    lower = np.flatnonzero(np.abs(vals.real - re[jj]) < TOL_DUPLICATE * scale)
-    upper = np.flatnonzero(np.abs(vals.real - re[jj + 1]) < TOL_DUPLICATE * scale)
+        return 0
+    for i in range(n):
+        lower[i] = abs(vals[i].real - re[jj]) < TOL_DUPLICATE * scale
+        upper[i] = abs(vals[i].real - re[jj + 1]) < TOL_DUPLICATE * scale
+    return 1
+
+
+@njit(cache=True)
+def _pulled(inter, rate):
+    """Whether an interaction eigenvalue pulls the pair together (below -1e-8 |rate|^2)."""
     norm = 1e-300
     for x in rate.flat:
         norm = max(norm, abs(x))
-    kl, ku = len(lower), len(upper)
+    for v in inter:
+        if v.real < -1e-8 * norm * norm:
+            return True
+    return False
+
+
+@njit(cache=True)
+def attraction(vals, vecs, inv, lower, upper, rate):
+    """Whether the pair ``lower``, ``upper`` can merge, from a full decomposition ``vals, vecs, inv``.
+
+    Two nearby eigenvalues interact, to first order in the load, through the entries ``B_lu``,
+    ``B_ul`` of ``rate = dA/dp`` in the biorthogonal eigenbasis; ``B_lu B_ul < 0`` pulls them
+    together (a possible bubble), ``> 0`` makes them veer apart, zero (to rounding) means they do
+    not interact. With repeated eigenvalues the interaction is the eigenvalues of the block
+    product ``B_lu B_ul``.
+    """
+    n = vals.shape[0]
+    low = np.flatnonzero(lower)
+    up = np.flatnonzero(upper)
+    kl, ku = len(low), len(up)
     b_lu = np.empty((kl, ku), dtype=np.complex128)
     b_ul = np.empty((ku, kl), dtype=np.complex128)
     for x in range(kl):
@@ -198,32 +223,67 @@ def attraction(vals, vecs, inv, rate):
                 row1 = 0j
                 row2 = 0j
                 for c in range(n):
-                    row1 += rate[r, c] * vecs[c, upper[y]]
-                    row2 += rate[r, c] * vecs[c, lower[x]]
-                s1 += inv[lower[x], r] * row1
-                s2 += inv[upper[y], r] * row2
+                    row1 += rate[r, c] * vecs[c, up[y]]
+                    row2 += rate[r, c] * vecs[c, low[x]]
+                s1 += inv[low[x], r] * row1
+                s2 += inv[up[y], r] * row2
             b_lu[x, y] = s1
             b_ul[y, x] = s2
     inter = np.empty(kl, dtype=np.complex128)
     _complex_eigvals(b_lu @ b_ul, inter)
-    for v in inter:
-        if v.real < -1e-8 * norm * norm:
-            return True
-    return False
+    return _pulled(inter, rate)
+
+
+@njit(cache=True)
+def simple_attraction(op, s_low, s_up, rate, w):
+    """:func:`attraction` for two simple eigenvalues, from four inverse iterations (no decomposition).
+
+    ``B_lu B_ul = (y_l^T R x_u)(y_u^T R x_l) / ((y_l^T x_l)(y_u^T x_u))`` with the right and left
+    eigenvectors ``x``, ``y`` of ``op`` for the two real eigenvalues. Returns 1 or 0, and -1 where
+    an inverse iteration fails (the caller decomposes instead). ``w`` is a work tuple.
+    """
+    n = op.shape[0]
+    opt, b, piv, xl, xu, yl, yu = w
+    norm = 0.0
+    for i in range(n):
+        row = 0.0
+        for j in range(n):
+            row += abs(op[i, j])
+            opt[i, j] = op[j, i]
+        norm = max(norm, row)
+    if not (_eigvector(op, n, s_low, norm, b, piv, xl) and _eigvector(op, n, s_up, norm, b, piv, xu)
+            and _eigvector(opt, n, s_low, norm, b, piv, yl) and _eigvector(opt, n, s_up, norm, b, piv, yu)):
+        return -1
+    lu = ul = ll = uu = 0.0
+    for r in range(n):
+        ru = 0.0
+        rl = 0.0
+        for c in range(n):
+            ru += rate[r, c] * xu[c]
+            rl += rate[r, c] * xl[c]
+        lu += yl[r] * ru
+        ul += yu[r] * rl
+        ll += yl[r] * xl[r]
+        uu += yu[r] * xu[r]
+    inter = np.empty(1, dtype=np.complex128)
+    inter[0] = lu * ul / (ll * uu)
+    return 1 if _pulled(inter, rate) else 0
 
 
 # -- the scan of every problem --------------------------------------------------------------------
 @njit(cache=True)
-def scan_stack(jobs, all_crossings, brk, count, start_unstable, status, ev):
-    """Brackets ``brk[j, :count[j]] = (stable load, unstable load)`` of every problem.
+def scan_stack(jobs, all_crossings, onsets, counts):
+    """The brackets of every problem into ``onsets[j, :, LO:HI + 1]`` (stable load, unstable load).
 
-    ``start_unstable[j]``: already unstable at the first grid point (no brackets);
-    ``status[j]`` 1 where the provider failed; ``ev[j]`` counts eigenproblems.
+    ``counts[j]``: the number of brackets, whether already unstable at the first grid point (then
+    no brackets), the status (1: the provider failed) and the eigenproblems solved
+    (:mod:`impstab.linear.engine.layout`).
     """
     n = jobs.a0.shape[1]
+    count = len(jobs.ints)
     big_chunk = 1
-    for c in jobs.chunk:
-        big_chunk = max(big_chunk, c)
+    for j in range(count):
+        big_chunk = max(big_chunk, jobs.ints[j, CHUNK])
     ws = workspace(n, big_chunk)
     cache = cache_new(n)
     npts_max = jobs.grids.shape[1]
@@ -235,16 +295,21 @@ def scan_stack(jobs, all_crossings, brk, count, start_unstable, status, ev):
     neg = np.empty((big_chunk, n), dtype=np.bool_)
     st = np.zeros(17)
     probe = np.zeros(1)
-    pair = np.zeros(2)
-    ops2 = np.empty((2, n, n))
+    trio = np.zeros(3)
+    ops3 = np.empty((3, n, n))
+    vals_grid = np.empty((npts_max, n), dtype=np.complex128)
+    lower = np.empty(n, dtype=np.bool_)
+    upper = np.empty(n, dtype=np.bool_)
+    pair_ws = (np.empty((n, n)), np.empty((n, n)), np.empty(n, dtype=np.int64), np.empty(n), np.empty(n),
+               np.empty(n), np.empty(n))
     counter = np.zeros(1, dtype=np.int64)
-    for j in range(len(jobs.form)):
+    for j in range(count):
         cache[0][:] = np.nan  # a new problem: nothing cached
         counter[0] = 0
-        npts = jobs.n_scan[j] + 1
+        npts = jobs.ints[j, N_SCAN] + 1
         grid = jobs.grids[j, :npts]
-        chunk = max(jobs.chunk[j], 1)
-        undamped = jobs.form[j] == 0
+        chunk = max(jobs.ints[j, CHUNK], 1)
+        undamped = jobs.ints[j, FORM] == 0
         known = 0
         found = 0
         failed = False
@@ -261,6 +326,7 @@ def scan_stack(jobs, all_crossings, brk, count, start_unstable, status, ev):
                         break
                     m = stop - known
                     _classify(ws[10][:m], ws[11][:m], undamped, flags[known:stop], ind[known:stop], cplx[:m], neg[:m])
+                    vals_grid[known:stop] = ws[10][:m]
                     known = stop
                 if failed or flags[0]:
                     break
@@ -268,9 +334,9 @@ def scan_stack(jobs, all_crossings, brk, count, start_unstable, status, ev):
                 break
             if flags[jj] != flags[jj - 1]:
                 if flags[jj - 1]:
-                    brk[j, found, 0], brk[j, found, 1] = grid[jj], grid[jj - 1]
+                    onsets[j, found, LO], onsets[j, found, HI] = grid[jj], grid[jj - 1]
                 else:
-                    brk[j, found, 0], brk[j, found, 1] = grid[jj - 1], grid[jj]
+                    onsets[j, found, LO], onsets[j, found, HI] = grid[jj - 1], grid[jj]
                 found += 1
             elif jj + 1 < npts and not flags[jj] and not flags[jj + 1]:
                 dips = (ind[jj, 0] < ind[jj - 1, 0] and ind[jj, 0] <= ind[jj + 1, 0],
@@ -281,13 +347,34 @@ def scan_stack(jobs, all_crossings, brk, count, start_unstable, status, ev):
                         continue
                     if column == 0 and undamped:
                         # search only where the two closest frequencies attract
-                        code, s = spectrum(jobs, j, grid[jj:jj + 1], True, cache, ws, counter)
-                        pair[0], pair[1] = grid[jj - 1], grid[jj + 1]
-                        if code == PROVIDER_ERROR or operators_at(jobs, j, pair, ops2) != 0:
-                            failed = True
-                            break
-                        if code == OK and not attraction(cache[2][s], cache[3][s], cache[4][s],
-                                                         (ops2[1] - ops2[0]) / (pair[1] - pair[0])):
+                        found_pair = closest_pair(vals_grid[jj], lower, upper)
+                        if found_pair == 0:
+                            continue
+                        pull = 1
+                        if found_pair == 1:
+                            trio[0], trio[1], trio[2] = grid[jj - 1], grid[jj], grid[jj + 1]
+                            if operators_at(jobs, j, trio, ops3) != 0:
+                                failed = True
+                                break
+                            rate = (ops3[2] - ops3[0]) / (trio[2] - trio[0])
+                            pull = -1
+                            if lower.sum() == 1 and upper.sum() == 1:
+                                s_low = vals_grid[jj, np.argmax(lower)].real
+                                s_up = vals_grid[jj, np.argmax(upper)].real
+                                pull = simple_attraction(ops3[1], s_low, s_up, rate, pair_ws)
+                                counter[0] += 1
+                            if pull < 0:  # repeated eigenvalues, or no inverse iteration: decompose
+                                code, s = spectrum(jobs, j, grid[jj:jj + 1], True, cache, ws, counter)
+                                if code == PROVIDER_ERROR:
+                                    failed = True
+                                    break
+                                pull = 1
+                                if code == OK:
+                                    rows = closest_pair(cache[2][s], lower, upper)
+                                    pull = 0 if rows == 0 else (1 if rows < 0 else
+                                                                (1 if attraction(cache[2][s], cache[3][s], cache[4][s],
+                                                                                 lower, upper, rate) else 0))
+                        if pull == 0:
                             continue
                     # the closest approach in (grid[jj-1], grid[jj+1]): the first unstable load met
                     probe[0] = fmin_start(st, grid[jj - 1], grid[jj + 1], (grid[jj + 1] - grid[jj - 1]) * 1e-9)
@@ -306,16 +393,16 @@ def scan_stack(jobs, all_crossings, brk, count, start_unstable, status, ev):
                         break
                 if not np.isnan(hit):
                     # stable at grid[jj-1]; unstable at hit; stable again by grid[jj+1]
-                    brk[j, found, 0], brk[j, found, 1] = grid[jj - 1], hit
+                    onsets[j, found, LO], onsets[j, found, HI] = grid[jj - 1], hit
                     found += 1
                     if all_crossings:
-                        brk[j, found, 0], brk[j, found, 1] = grid[jj + 1], hit
+                        onsets[j, found, LO], onsets[j, found, HI] = grid[jj + 1], hit
                         found += 1
             if found and not all_crossings:
                 break
             jj += 1
-        ev[j] += counter[0]
-        status[j] = 1 if failed else 0
-        start_unstable[j] = flags[0] and not failed
-        count[j] = 0 if (failed or flags[0]) else found
+        counts[j, EVALUATIONS] += counter[0]
+        counts[j, STATUS] = 1 if failed else 0
+        counts[j, START_UNSTABLE] = 1 if (flags[0] and not failed) else 0
+        counts[j, BRACKETS] = 0 if (failed or flags[0]) else found
         flags[:npts] = False

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections import namedtuple
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -10,8 +10,11 @@ from numpy.typing import NDArray
 
 from ..blocks import decoupled_blocks
 from ..eigen import kinetic_shares
+from .layout import (AFFINE, BISECTIONS, BRACKETS, DIRECTION, EVALUATIONS, FIRST, HI, KIND, LARGEST, LO, LOAD,
+                     N_SCAN, OMEGA, START_UNSTABLE, STATUS, WARNED, Jobs)
 from .refine import LIMIT, refine_stack
 from .scan import scan_stack
+from . import large
 from .problems import Problem
 from .spectra import register, unregister
 from .tolerances import TOL_UNSTABLE
@@ -22,11 +25,6 @@ Array = NDArray[np.float64]
 
 #: scan points classified per call of a provider (affine problems: one at a time)
 PROVIDER_CHUNK = 16
-
-#: the compiled loop's view of a stack of problems of one operator order
-Jobs = namedtuple("Jobs", "form affine key a0 a1 order starts nblocks largest grids n_scan chunk weights p_lo p_hi")
-#: its results: per bracket, and per problem
-Results = namedtuple("Results", "first load kind omega direction warned limit mode part evaluations bisections")
 
 _KINDS = {1: "flutter", 2: "divergence"}
 
@@ -65,46 +63,52 @@ class Outcome:
     method: str = field(default="")
 
 
-def _stack(problems: list[Problem], all_crossings: bool, chunk: int):
+@functools.lru_cache(maxsize=256)
+def _grid(p_min: float, p_max: float, n_scan: int) -> Array:
+    grid = np.linspace(p_min, p_max, n_scan + 1)
+    grid.setflags(write=False)
+    return grid
+
+
+def _jobs(problems: list[Problem], chunk: int) -> tuple[Jobs, list[int]]:
+    """The stack's arrays (:mod:`~impstab.linear.engine.layout`) and the providers' keys."""
     count = len(problems)
-    n = problems[0].order
-    n_dof = problems[0].n_dof
-    g = max(p.n_scan for p in problems) + 1
+    n, n_dof = problems[0].order, problems[0].n_dof
+    keys = [-1 if p.affine else register(p.provider) for p in problems]
+    ints = np.array([(0 if p.undamped else 1, p.affine, k, p.n_scan, 1 if p.affine else chunk, n)
+                     for p, k in zip(problems, keys)], dtype=np.int64)
+    span = np.array([(p.p_min, p.p_max) for p in problems])
+    grids = np.zeros((count, max(p.n_scan for p in problems) + 1))
+    for i, p in enumerate(problems):
+        grids[i, : p.n_scan + 1] = _grid(p.p_min, p.p_max, p.n_scan)
+    if max(keys) < 0:  # the usual stack: affine problems only
+        if count == 1:
+            a0, a1 = problems[0].operators()
+            a0, a1, weights = a0[None], a1[None], problems[0].weights[None]
+        else:
+            ops = [p.operators() for p in problems]
+            a0 = np.stack([o[0] for o in ops])
+            a1 = np.stack([o[1] for o in ops])
+            weights = np.stack([p.weights for p in problems])
+        bs = decoupled_blocks(a0, a1, np.array([max(abs(p.p_min), abs(p.p_max)) for p in problems]))
+        ints[:, LARGEST] = bs.largest
+        return Jobs(ints, span, grids, a0, a1, bs.order, bs.starts, bs.nblocks, weights), []
     a0 = np.zeros((count, n, n))
     a1 = np.zeros((count, n, n))
-    affine = np.array([p.affine for p in problems], dtype=np.bool_)
     weights = np.ones((count, n_dof))
-    grids = np.zeros((count, g))
     for i, p in enumerate(problems):
         if p.affine:
-            a0[i], a1[i] = p.a0, p.a1
-            weights[i] = p.weights
-        grids[i, : p.n_scan + 1] = np.linspace(p.p_min, p.p_max, p.n_scan + 1)
-    order = np.tile(np.arange(n), (count, 1))
+            (a0[i], a1[i]), weights[i] = p.operators(), p.weights
+    order = np.empty((count, n), dtype=np.int64)
+    order[:] = np.arange(n)
     starts = np.full((count, n + 1), n, dtype=np.int64)
     starts[:, 0] = 0
     nblocks = np.ones(count, dtype=np.int64)
-    largest = np.full(count, n, dtype=np.int64)
-    rows = np.flatnonzero(affine)
+    rows = np.flatnonzero(ints[:, AFFINE])
     if rows.size:
-        reach = np.array([max(abs(problems[r].p_min), abs(problems[r].p_max)) for r in rows])
-        bs = decoupled_blocks(a0[rows], a1[rows], reach)
-        order[rows], starts[rows], nblocks[rows], largest[rows] = bs.order, bs.starts, bs.nblocks, bs.largest
-    keys = np.array([-1 if p.affine else register(p.provider) for p in problems], dtype=np.int64)
-    jobs = Jobs(
-        np.array([0 if p.undamped else 1 for p in problems], dtype=np.int64), affine, keys, a0, a1,
-        order, starts, nblocks, largest, grids, np.array([p.n_scan for p in problems], dtype=np.int64),
-        np.where(affine, 1, chunk).astype(np.int64), weights,
-        np.array([p.p_min for p in problems]), np.array([p.p_max for p in problems]),
-    )
-    cap = 2 * g
-    res = Results(
-        np.full(count, -1, dtype=np.int64), np.full((count, cap), np.nan), np.zeros((count, cap), dtype=np.int64),
-        np.full((count, cap), np.nan), np.zeros((count, cap), dtype=np.int64), np.zeros((count, cap), dtype=np.bool_),
-        np.full((count, cap, 2), np.nan), np.zeros((count, n_dof), dtype=np.complex128), np.zeros((count, n_dof)),
-        np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64),
-    )
-    return jobs, res, keys, cap
+        bs = decoupled_blocks(a0[rows], a1[rows], np.abs(span[rows]).max(axis=1))
+        order[rows], starts[rows], nblocks[rows], ints[rows, LARGEST] = bs.order, bs.starts, bs.nblocks, bs.largest
+    return Jobs(ints, span, grids, a0, a1, order, starts, nblocks, weights), [k for k in keys if k >= 0]
 
 
 def solve(problems: list[Problem], *, all_crossings: bool = False, chunk: int = PROVIDER_CHUNK) -> list[Outcome]:
@@ -115,26 +119,63 @@ def solve(problems: list[Problem], *, all_crossings: bool = False, chunk: int = 
     """
     outcomes: list[Outcome | None] = [None] * len(problems)
     groups: dict[tuple[int, int], list[int]] = {}
+    notes: dict[int, tuple[str, ...]] = {}
     for i, p in enumerate(problems):
+        if not all_crossings and large.reducible(p):
+            outcomes[i], reason = _solve_large(p, chunk)
+            if outcomes[i] is not None:
+                continue
+            notes[i] = (f"modal reduction not used: {reason}; solved dense",)
         groups.setdefault((p.order, p.n_dof), []).append(i)
-    for members in groups.values():
+    for (n, n_dof), members in groups.items():
         group = [problems[i] for i in members]
-        jobs, res, keys, cap = _stack(group, bool(all_crossings), int(chunk))
+        jobs, keys = _jobs(group, int(chunk))
         count = len(group)
-        brk = np.zeros((count, cap, 2))
-        n_brk = np.zeros(count, dtype=np.int64)
-        start = np.zeros(count, dtype=np.bool_)
-        status = np.zeros(count, dtype=np.int64)
+        onsets = np.full((count, 2 * jobs.grids.shape[1], 7), np.nan)
+        counts = np.zeros((count, 6), dtype=np.int64)
+        mode = np.zeros((count, n_dof), dtype=np.complex128)
+        part = np.zeros((count, n_dof))
         try:
-            scan_stack(jobs, bool(all_crossings), brk, n_brk, start, status, res.evaluations)
-            refine_stack(jobs, brk, n_brk, start, status, res)
+            scan_stack(jobs, bool(all_crossings), onsets, counts)
+            refine_stack(jobs, onsets, mode, part, counts)
         finally:
             for k in keys:
-                if k >= 0:
-                    unregister(int(k))
+                unregister(k)
         for r, i in enumerate(members):
-            outcomes[i] = _outcome(group[r], res, r, int(n_brk[r]), bool(start[r]), int(status[r]), all_crossings)
+            outcomes[i] = _outcome(group[r], onsets[r], mode[r], part[r], counts[r], all_crossings, notes.get(i, ()))
     return outcomes  # type: ignore[return-value]
+
+
+def _solve_large(problem: Problem, chunk: int) -> tuple[Outcome | None, str]:
+    """A large undamped problem by modal reduction with error checks (:mod:`~impstab.linear.engine.large`).
+
+    Returns the outcome, or None and the reason where the problem must be solved dense.
+    """
+    n = problem.order
+    m = large.BASIS
+    evaluations = 0
+    while True:
+        m2 = min(2 * m, n - 1)
+        w, phi = large.modal_basis(problem, m2)
+        small, big = solve([large.reduced_problem(problem, w[:m], phi[:, :m]), large.reduced_problem(problem, w, phi)],
+                           chunk=chunk)
+        evaluations += small.evaluations + big.evaluations
+        if small.load is None and big.load is None:
+            if not large.stable_at(problem, problem.p_max):
+                return None, "the full model is unstable at p_max although the reduced models are not"
+            return Outcome(None, "none", None, None, None, (), evaluations + 1, big.warnings, method="coalescence"), ""
+        if small.load is not None and big.load is not None and small.kind == big.kind \
+                and abs(small.load - big.load) <= large.TRUNCATION_TOLERANCE * abs(big.load):
+            break
+        if 2 * m2 > n:
+            return None, f"the onsets with {m} and {m2} modes disagree"
+        m = m2
+    width = max(10 * abs(small.load - big.load) / abs(big.load), 1e-8)
+    onset, reason = large.full_onset(problem, big.load, big.kind, big.omega, w, phi, width)
+    if onset is None:
+        return None, reason
+    p, kind, omega, mode, part = onset
+    return Outcome(p, kind, omega, mode, part, (), evaluations + 1, big.warnings, method="coalescence"), ""
 
 
 def _warning(load: float) -> str:
@@ -143,42 +184,41 @@ def _warning(load: float) -> str:
             "relative accuracy near that tolerance (very light damping?)")
 
 
-def _outcome(problem: Problem, res: Results, r: int, n_brk: int, start: bool, status: int,
-             all_crossings: bool) -> Outcome:
+def _outcome(problem: Problem, onsets, mode, part, counts, all_crossings: bool, notes: tuple = ()) -> Outcome:
     method = "coalescence" if problem.undamped else "hopf"
-    evaluations = int(res.evaluations[r])
-    if status != 0:
+    evaluations, bisections = int(counts[EVALUATIONS]), int(counts[BISECTIONS])
+    if counts[STATUS] != 0:
         err = getattr(problem.provider, "error", None) or RuntimeError("the stability engine stopped")
         return Outcome(None, "none", None, None, None, (), evaluations, (), err, method=method)
-    if start:
-        return Outcome(float(res.load[r, 0]), _KINDS[int(res.kind[r, 0])], float(res.omega[r, 0]),
-                       res.mode[r].copy(), res.part[r].copy(), (), evaluations, unstable_at_start=True,
-                       method=method)
-    found: list[tuple] = []
-    warnings: list[str] = []
-    first = int(res.first[r])
-    first_values = None
+    if counts[START_UNSTABLE]:
+        row = onsets[0]
+        return Outcome(float(row[LOAD]), _KINDS[int(row[KIND])], float(row[OMEGA]), mode.copy(), part.copy(), (),
+                       evaluations, unstable_at_start=True, method=method)
+    found: list[Crossing] = []
+    warnings: list[str] = list(notes)
+    first = int(counts[FIRST])
+    best = None
     if first >= 0:
-        first_values = (float(res.load[r, first]), _KINDS[int(res.kind[r, first])], float(res.omega[r, first]),
-                        res.mode[r].copy(), res.part[r].copy())
-    for i in range(n_brk):
-        direction = "loss" if res.direction[r, i] > 0 else "gain"
-        if res.kind[r, i] == LIMIT:
-            p, kind, omega, mode, part = limit_point(problem, float(res.limit[r, i, 0]), float(res.limit[r, i, 1]))
-            if direction == "loss" and (first_values is None or p < first_values[0]):
-                first_values = (p, kind, omega, mode, part)
+        row = onsets[first]
+        best = (float(row[LOAD]), _KINDS[int(row[KIND])], float(row[OMEGA]), mode.copy(), part.copy())
+    for row in onsets[: counts[BRACKETS]]:
+        direction = "loss" if row[DIRECTION] > 0 else "gain"
+        if row[KIND] == LIMIT:
+            p, kind, omega, m, pa = limit_point(problem, float(row[LO]), float(row[HI]))
+            if direction == "loss" and (best is None or p < best[0]):
+                best = (p, kind, omega, m, pa)
         else:
-            p, kind, omega = float(res.load[r, i]), _KINDS[int(res.kind[r, i])], float(res.omega[r, i])
-        if res.warned[r, i]:
+            p, kind, omega = float(row[LOAD]), _KINDS[int(row[KIND])], float(row[OMEGA])
+        if row[WARNED]:
             warnings.append(_warning(p))
         found.append(Crossing(p, direction, kind, omega))
     found.sort(key=lambda c: c.load)
-    if first_values is None:
+    if best is None:
         return Outcome(None, "none", None, None, None, tuple(found), evaluations, tuple(warnings),
-                       bisections=int(res.bisections[r]), method=method)
-    p, kind, omega, mode, part = first_values
-    return Outcome(p, kind, omega, mode, part, tuple(found) if all_crossings else (), evaluations, tuple(warnings),
-                   bisections=int(res.bisections[r]), method=method)
+                       bisections=bisections, method=method)
+    p, kind, omega, m, pa = best
+    return Outcome(p, kind, omega, m, pa, tuple(found) if all_crossings else (), evaluations, tuple(warnings),
+                   bisections=bisections, method=method)
 
 
 def limit_point(problem: Problem, a: float, b: float):

@@ -33,6 +33,7 @@ from numba import njit, objmode
 
 from ..blocks import block_eig_at, block_eigvals_at, eig_workspace
 from ..small_eig import MAX_ORDER, _solve_one
+from .layout import AFFINE, KEY, LARGEST
 
 __all__ = ["register", "unregister", "spectrum", "workspace", "cache_new", "operators_at",
            "OK", "FAILED", "NOT_FINITE", "PROVIDER_ERROR"]
@@ -157,7 +158,7 @@ def _finite(a):
 @njit(cache=True)
 def operators_at(jobs, j, loads, out):
     """``out[i] = A_j(loads[i])``; returns 0, or 1 when the provider failed."""
-    if jobs.affine[j]:
+    if jobs.ints[j, AFFINE]:
         n = out.shape[1]
         for i in range(len(loads)):
             p = loads[i]
@@ -165,7 +166,7 @@ def operators_at(jobs, j, loads, out):
                 for c in range(n):
                     out[i, r, c] = jobs.a0[j, r, c] + p * jobs.a1[j, r, c]
         return 0
-    return _provided_operators(jobs.key[j], loads, out)
+    return _provided_operators(jobs.ints[j, KEY], loads, out)
 
 
 @njit(cache=True)
@@ -195,7 +196,7 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     """
     m = len(loads)
     n = jobs.a0.shape[1]
-    compiled = jobs.affine[j] and jobs.largest[j] <= MAX_ORDER
+    compiled = jobs.ints[j, AFFINE] == 1 and jobs.ints[j, LARGEST] <= MAX_ORDER
     ops = ws[5]
     if not vectors:
         vals, lost = ws[10], ws[11]
