@@ -172,11 +172,15 @@ def _pair_growth(v, k):
 
 
 @njit(cache=True)
-def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, derivative, sel, share):
+def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, derivative, sel, share, coalesce=False):
     """``(f, df, clear)``: the exact indicator of the cluster in the decomposition, its derivative.
 
     ``df`` (affine problems, ``derivative``) from the eigenvalue derivatives ``W_C A1 V_C``;
     ``clear`` False where the cluster is not found clearly (then the values mean nothing).
+    ``coalesce`` (first-order problems whose crossing branch lay on the imaginary axis): the
+    discriminant of the cluster's upper half, ``Re(m sum lambda^2 - (sum lambda)^2)``, negative
+    while two frequencies ``i w_1, i w_2`` are distinct, positive once they have split into
+    ``+-a + i b``, and like the undamped ``Delta`` analytic through the defective double root.
     """
     if not select(vecs, vc, wc, k, sel, share):
         return 0.0, 0.0, False
@@ -184,13 +188,23 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
     for i in range(k):
         v[i] = vals[sel[i]]
     jj = 0
-    if undamped:
+    half = np.ones(k, dtype=np.bool_)
+    if coalesce:
+        upper = False
+        for i in range(k):
+            upper = upper or v[i].imag > 0
+        for i in range(k):
+            half[i] = not upper or v[i].imag >= 0
+    if undamped or coalesce:
         s1 = 0j
         s2 = 0j
+        m = 0
         for i in range(k):
-            s1 += v[i]
-            s2 += v[i] * v[i]
-        f = s1.real / k if divergence else (k * s2 - s1 * s1).real
+            if half[i]:
+                s1 += v[i]
+                s2 += v[i] * v[i]
+                m += 1
+        f = s1.real / k if divergence else (m * s2 - s1 * s1).real
     else:
         best = -np.inf
         for i in range(k):
@@ -214,7 +228,7 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
                 row += a1[r, c] * vecs[c, c0]
             acc += w * row
         b[i] = acc
-    if not undamped:
+    if not (undamped or coalesce):
         return f, b[jj].real, True
     if divergence:
         df = 0.0
@@ -224,11 +238,14 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
     s1 = 0j
     sb = 0j
     svb = 0j
+    m = 0
     for i in range(k):
-        s1 += v[i]
-        sb += b[i]
-        svb += v[i] * b[i]
-    return f, (2 * k * svb - 2 * s1 * sb).real, True
+        if half[i]:
+            s1 += v[i]
+            sb += b[i]
+            svb += v[i] * b[i]
+            m += 1
+    return f, (2 * m * svb - 2 * s1 * sb).real, True
 
 
 # -- roots, as steps (reverse communication) ------------------------------------------------------
@@ -307,11 +324,14 @@ def brent_step(st, f):
 
 # -- onset values -------------------------------------------------------------------------------
 @njit(cache=True)
-def onset_values(vals, vecs, members, k, undamped, divergence, shapes, values, weights, mode, part):
+def onset_values(vals, vecs, members, k, undamped, divergence, shapes, values, weights, mode, part, coalesce=False):
     """Kind and omega of the onset, its mode (largest component 1) and participation.
 
     ``vals, vecs``: the decomposition at the onset, ``members[:k]`` the cluster's columns;
-    ``shapes (n, k), values (k,)``: the distinct modes the participation is taken from.
+    ``shapes (n, k), values (k,)``: the distinct modes the participation is taken from. Where two
+    frequencies merge (undamped, or ``coalesce``: first order on the imaginary axis) omega comes
+    from the cluster's mean, a symmetric function: the individual eigenvalues of the defective
+    double root carry sqrt(eps) noise, their mean only eps.
     """
     n = mode.shape[0]
     lead = members[0]
@@ -329,6 +349,14 @@ def onset_values(vals, vecs, members, k, undamped, divergence, shapes, values, w
             if vals[members[i]].real > vals[lead].real:
                 lead = members[i]
         omega = 0.0 if divergence else abs(vals[lead].imag)
+        if coalesce:
+            mean = 0.0
+            m = 0
+            for i in range(k):
+                if vals[members[i]].imag >= 0:
+                    mean += vals[members[i]].imag
+                    m += 1
+            omega = mean / max(m, 1)
     big = 0
     for r in range(n):
         mode[r] = vecs[r, lead]
@@ -412,6 +440,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
             vals_r = np.empty(n, dtype=np.complex128)
             vecs_r = np.empty((n, n), dtype=np.complex128)
             last = np.nan
+            coalesce = False
             steps = 0 if start_unstable else 200
             for _ in range(steps):
                 point[0] = b
@@ -447,10 +476,11 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                     ok_a = code_a != NOT_FINITE and select(cache[3][sa], vc, wc, k, sel, share)
                     while unique and ok_a:  # the exact route (a loop only to leave it early)
                         target = 0.0
+                        coalesce = False
                         if not undamped:
-                            # on the imaginary axis (to rounding) at a and a step before it? Then the
-                            # branch leaves like sqrt(p - p_c), and the onset is where it is off the
-                            # axis by TOL_UNSTABLE
+                            # on the imaginary axis (to rounding) at a and a step before it? Then two
+                            # frequencies merge there (the discriminant of the cluster's upper half
+                            # crosses zero linearly), or a branch leaves through zero
                             marginal = True
                             for p in (a, min(max(a + (a - b), lo_lim), hi_lim)):
                                 point[0] = p
@@ -468,8 +498,11 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                     break
                             if failed:
                                 break
-                            if marginal:
+                            if marginal and divergence:
+                                # the branch leaves the axis through zero like sqrt(p - p_c): the onset
+                                # is where it is off the axis by TOL_UNSTABLE
                                 target = TOL_UNSTABLE
+                            coalesce = marginal and not divergence
                         fab = np.zeros(2)
                         clear = True
                         for e in range(2):
@@ -479,7 +512,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 failed = True
                                 break
                             f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
-                                                 divergence, target, False, sel, share)
+                                                 divergence, target, False, sel, share, coalesce)
                             clear = clear and code != NOT_FINITE and ok
                             fab[e] = f
                         if failed or not clear:
@@ -490,7 +523,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         elif np.sign(fa) == np.sign(fb):
                             step_back = True
                             break
-                        elif affine and target == 0.0 and (undamped or k <= 2):
+                        elif affine and target == 0.0 and (undamped or k <= 2 or coalesce):
                             st[0], st[1], st[2], st[3] = a, b, fa, np.nan
                             p = a - fa * (b - a) / (fb - fa)
                             for _ in range(100):
@@ -502,7 +535,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 if code != OK:
                                     break
                                 f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc,
-                                                      k, divergence, 0.0, True, sel, share)
+                                                      k, divergence, 0.0, True, sel, share, coalesce)
                                 if not ok:
                                     break
                                 p, done = newton_step(st, p, f, df)
@@ -524,7 +557,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                     failed = True
                                     break
                                 f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
-                                                     divergence, target, False, sel, share)
+                                                     divergence, target, False, sel, share, coalesce)
                                 if code == NOT_FINITE or not ok:
                                     break
                         break
@@ -579,6 +612,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 # the exact indicator could not be used (or the problem is unstable at the start):
                 # the onset values at b, from its unstable cluster
                 warned = not start_unstable
+                coalesce = False
                 root = b
                 point[0] = b
                 code, s = spectrum(jobs, j, point, True, cache, ws, ev)
@@ -599,7 +633,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 failed = True
                 break
             kind, omega = onset_values(vals_r, vecs_r, cols, k, undamped, divergence, shapes, values, weights, mode,
-                                       part)
+                                       part, coalesce)
             onsets[j, t, LOAD], onsets[j, t, KIND], onsets[j, t, OMEGA] = root, kind, omega
             onsets[j, t, WARNED] = 1.0 if warned else 0.0
             if start_unstable or (a < b and (first < 0 or root < onsets[j, first, LOAD])):

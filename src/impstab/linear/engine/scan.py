@@ -8,7 +8,8 @@ stability rule). The points are examined in order:
 * a change of stability between neighbours is a bracket ``(stable, unstable)``;
 * between stable points, where the bubble indicator has a local minimum -- the closest gap
   between two frequencies, or the smallest ``s`` (undamped); minus the largest growth rate
-  (first-order problems) -- an instability may hide between the grid points: the minimum is
+  (first-order problems), or where that is zero to rounding (a conservative system in first-order
+  form) the closest gap between two frequencies -- an instability may hide between the grid points: the minimum is
   located by bounded minimisation (scipy's ``fminbound``, ported step for step) and the first
   unstable point it meets closes a bracket. For a frequency gap of an undamped problem, only
   when the two modes can merge: their first-order interaction ``B_lu B_ul`` in the biorthogonal
@@ -27,7 +28,7 @@ from ..classify import _indicators, _masks
 from ..small_eigvec import _eigvector
 from .layout import BRACKETS, CHUNK, EVALUATIONS, FORM, HI, LO, N_SCAN, START_UNSTABLE, STATUS
 from .spectra import OK, PROVIDER_ERROR, cache_new, operators_at, spectrum, workspace
-from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_UNSTABLE
+from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
 
 __all__ = ["scan_stack"]
 
@@ -341,9 +342,15 @@ def scan_stack(jobs, all_crossings, onsets, counts):
             elif jj + 1 < npts and not flags[jj] and not flags[jj + 1]:
                 dips = (ind[jj, 0] < ind[jj - 1, 0] and ind[jj, 0] <= ind[jj + 1, 0],
                         ind[jj, 1] < ind[jj - 1, 1] and ind[jj, 1] <= ind[jj + 1, 1])
+                # first order: where every growth rate is zero to rounding at the three points
+                # (a conservative system), the growth rate's dips are noise and a bubble shows as
+                # a close approach of two frequencies instead (column 1)
+                marginal = not undamped and max(abs(ind[jj - 1, 0]), abs(ind[jj, 0]), abs(ind[jj + 1, 0])) <= TOL_MARGINAL
                 hit = np.nan
                 for column in (1, 0):
-                    if not dips[column] or not np.isnan(hit) or (column == 1 and not undamped):
+                    if not dips[column] or not np.isnan(hit):
+                        continue
+                    if not undamped and (column == 1) != marginal:
                         continue
                     if column == 0 and undamped:
                         # search only where the two closest frequencies attract
