@@ -18,6 +18,9 @@ Measured in one run on this machine:
 * **coupled** -- the same measurement of sweep and loop on a layout with no decoupled blocks
   (the asymmetric example, classical linearization, over the first mount's x and shear
   stiffness), so that the figure for designs the block route cannot help is in the same line.
+  Beside it the **compiled eigenvalue floor** (:func:`eigenvalue_floor`): the time of just the
+  eigenvalue problems these designs need, with the compiled small-matrix routines, and
+  ``floor_ratio``, the sweep's time per design over it.
 * **workers** -- the same study on a ``dask.distributed.LocalCluster`` of 1 and 2 worker
   processes (one thread each), cluster started and warmed up (one chunk on every worker)
   before the clock starts; the fastest of ``--repeat`` runs counts (the timeit convention),
@@ -109,6 +112,48 @@ def loop_time(study, designs: np.ndarray) -> float:
     return (time.perf_counter() - t0) / len(dicts)
 
 
+def eigenvalue_floor(study, designs: np.ndarray, repeat: int = 5) -> dict:
+    """The compiled eigenvalue floor of the designs: the time of just their eigenvalue problems.
+
+    The engine's own counts on these designs (bulk-assembled, as the sweep solves them): the
+    eigenproblems with eigenvectors at the compiled decomposition's time (``eig_affine``, per
+    problem on a stack of the designs' operators), every other one -- eigenvalues only, and the
+    pair vectors of the attraction test -- at the compiled eigenvalue routine's
+    (``eigvals_affine_blocks``), a lower bound for the latter. Best of ``repeat``.
+    """
+    from impstab.linear.batch import critical_thrust_batch
+    from impstab.linear.blocks import decoupled_blocks, eig_affine, eigvals_affine_blocks
+    from impstab.studies.bulk import assemble_bulk
+
+    segs = [p.path.segments for p in study.parameters]
+    idx = np.unravel_index(designs, study.shape)
+    cols = [np.asarray(p.values)[i] for p, i in zip(study.parameters, idx)]
+    bulk = assemble_bulk(study.base_model, segs, cols)
+    models = [d for d in bulk.designs if d is not None]
+    res = critical_thrust_batch(models)
+    a0 = np.stack([np.linalg.solve(d.mass, d.k0) for d in models])
+    a1 = np.stack([np.linalg.solve(d.mass, d.k1) for d in models])
+    t_max = np.array([d.thrust_max for d in models])
+    blocks = decoupled_blocks(a0, a1, t_max)
+    loads = t_max[:, None] * np.linspace(0.0, 1.0, 65)[None]
+    mid = 0.5 * t_max
+    eigvals_affine_blocks(a0, a1, loads, blocks)
+    eig_affine(a0, a1, mid, blocks)
+    t_vals = t_vecs = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        eigvals_affine_blocks(a0, a1, loads, blocks)
+        t_vals = min(t_vals, (time.perf_counter() - t0) / loads.size)
+        t0 = time.perf_counter()
+        eig_affine(a0, a1, mid, blocks)
+        t_vecs = min(t_vecs, (time.perf_counter() - t0) / len(models))
+    values_only = res.evaluations - res.decompositions
+    floor = (values_only * t_vals + res.decompositions * t_vecs) / len(models)
+    return {"floor_us_per_design": floor * 1e6, "eigenvalue_us": t_vals * 1e6, "decomposition_us": t_vecs * 1e6,
+            "eigenvalue_problems_per_design": values_only / len(models),
+            "decompositions_per_design": res.decompositions / len(models), "designs": len(models)}
+
+
 def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng) -> dict:
     """Sweep and loop on the asymmetric example (classical linearization): no decoupled blocks."""
     text = COUPLED_EXAMPLE.read_text()
@@ -121,8 +166,10 @@ def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng) -> dict:
     seconds, _ = timed_study(study, tmp / "coupled.zarr")
     subset = rng.choice(study.size, size=min(loop_sample, study.size), replace=False)
     t_loop = loop_time(study, subset)
+    floor = eigenvalue_floor(study, rng.choice(study.size, size=min(1000, study.size), replace=False))
     return {"designs_per_s": study.size / seconds, "speedup_vs_loop": t_loop * study.size / seconds,
-            "loop_us_per_design": t_loop * 1e6}
+            "loop_us_per_design": t_loop * 1e6, "eigenvalue_floor": floor,
+            "floor_ratio": seconds / study.size / (floor["floor_us_per_design"] * 1e-6)}
 
 
 def timed_study(study, store: Path, **kw) -> tuple[float, object]:
@@ -240,6 +287,11 @@ def main() -> int:
             coupled = coupled_rates(tmp, args.n, args.chunk, args.loop_sample, rng)
             print(f"coupled layout   {coupled['designs_per_s']:,.0f} designs/s, loop {coupled['loop_us_per_design']:.0f} "
                   f"us/design: {coupled['speedup_vs_loop']:.2f}x (asymmetric example, no decoupled blocks)")
+            fl = coupled["eigenvalue_floor"]
+            print(f"eigenvalue floor {fl['floor_us_per_design']:.1f} us/design: {fl['eigenvalue_problems_per_design']:.1f} "
+                  f"eigenvalue problems x {fl['eigenvalue_us']:.2f} us + {fl['decompositions_per_design']:.1f} "
+                  f"decompositions x {fl['decomposition_us']:.2f} us (compiled); the coupled sweep takes "
+                  f"{coupled['floor_ratio']:.2f}x that")
         workers, at_scale, parallel = {}, {}, None
         if not args.no_workers:
             workers, _ = scaling(study, tmp, args.repeat)

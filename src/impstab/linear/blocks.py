@@ -78,7 +78,7 @@ class BlockStructure:
         return BlockStructure(self.order[rows], self.starts[rows], self.nblocks[rows], self.largest[rows])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _structure(a0, a1, p_max, tol, order, starts, nblocks, largest):
     count, n = a0.shape[0], a0.shape[1]
     c = np.empty((n, n))
@@ -158,7 +158,7 @@ def decoupled_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], p_max: ND
     return BlockStructure(order, starts, nblocks, largest)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _values2(a, b, c, d):
     """Eigenvalues of ``[[a, b], [c, d]]`` (LAPACK ``dlanv2``'s standardisation, unscaled)."""
     p = 0.5 * (a - d)
@@ -174,7 +174,7 @@ def _values2(a, b, c, d):
     return complex(m, w), complex(m, -w)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _vector2(lam, a, b, c, d, first):
     """Unit eigenvector of ``[[a, b], [c, d]]`` for ``lam``: the larger of the two row solutions."""
     x1, y1 = complex(b, 0.0), lam - a
@@ -193,7 +193,7 @@ def _vector2(lam, a, b, c, d, first):
     return complex(0.0, 0.0), complex(1.0, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _fill_block(a0, a1, s, p, order, lo, m, w):
     """``w[:m, :m]`` = the block of dofs ``order[s, lo:lo + m]`` of ``a0[s] + p a1[s]``."""
     for x in range(m):
@@ -202,7 +202,7 @@ def _fill_block(a0, a1, s, p, order, lo, m, w):
             w[x, y] = a0[s, i, j] + p * a1[s, i, j]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def block_eigvals_at(a0, a1, s, p, order, starts, nblocks, w, v, wr, wi, out):
     """Eigenvalues of design ``s`` at load ``p``, block by block, into ``out (n,)``; False: failed.
 
@@ -227,7 +227,7 @@ def block_eigvals_at(a0, a1, s, p, order, starts, nblocks, w, v, wr, wi, out):
     return good
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _eigvals_blocks(a0, a1, loads, order, starts, nblocks, out, ok):
     n = a0.shape[1]
     w = np.empty((n, n))
@@ -256,7 +256,7 @@ def eigvals_affine_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], load
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def eig_workspace(n):
     """Work arrays of :func:`block_eig_at` for operators of order ``n``."""
     return (np.empty((n, n)), np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n),
@@ -265,7 +265,7 @@ def eig_workspace(n):
             np.empty(n, dtype=np.int64), np.empty(n, dtype=np.complex128), np.empty((n, n)), np.empty(n))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def block_eig_at(a0, a1, s, p, order, starts, nblocks, vals, vecs, inv, ws):
     """Eigen-decomposition of design ``s`` at load ``p``, block by block; False: failed.
 
@@ -323,7 +323,7 @@ def block_eig_at(a0, a1, s, p, order, starts, nblocks, vals, vecs, inv, ws):
     return good
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _eig_blocks(a0, a1, loads, order, starts, nblocks, vals, vecs, inv, ok):
     """Eigen-decomposition of each design, block by block (closed forms up to two dofs)."""
     ws = eig_workspace(a0.shape[1])

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 __all__ = ["unstable_masks", "classify_eigenvalues"]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _masks(vals, undamped, tol_unstable, tol_cluster, floor_rel, cplx, neg):
     count, n = vals.shape
     for s in range(count):
@@ -49,7 +49,7 @@ def _masks(vals, undamped, tol_unstable, tol_cluster, floor_rel, cplx, neg):
                 neg[s, i] = grow and real
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _indicators(vals, undamped, cplx, neg, tol_duplicate, unstable, indicator):
     count, n = vals.shape
     re = np.empty(n)

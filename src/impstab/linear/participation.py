@@ -24,7 +24,7 @@ from .small_eigvec import _lu, _lu_solve
 __all__ = ["participation_into"]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def participation_into(shapes, values, members, weights, tol, out):
     """Shares of each dof in the cluster ``members`` of ``shapes (n, k)`` into ``out (n,)``.
 

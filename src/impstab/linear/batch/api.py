@@ -7,9 +7,9 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ...model.model import Model
-from ..critical_thrust import _modes
-from ..engine import Problem, second_order_problem, solve
+from ...model.model import DOF_NAMES, Model
+from ..critical_thrust import PARTICIPATION_THRESHOLD, _modes
+from ..engine import Problem, StackOutcome, second_order_problem, solve, solve_affine
 from ..linearize import ModelFamily
 from .results import KINDS, STATUSES, AffineDesign, BatchCriticalThrust
 
@@ -24,13 +24,31 @@ def _single(model: Model) -> tuple:
     return (r.thrust, r.kind, r.omega, r.participation, r.warnings), (r.undamped_thrust, r.undamped_kind)
 
 
-def _affine_problems(designs: list[AffineDesign], n_scan: int) -> list[Problem]:
-    """The undamped problems ``M^-1 K0 + T M^-1 K1`` of designs given by their matrices, formed at once."""
+def _affine_stack(designs: list[AffineDesign], n_scan: int, vectorized: bool):
+    """The undamped problems ``M^-1 K0 + T M^-1 K1`` of designs given by their matrices, solved at once."""
     m = np.stack([d.mass for d in designs])
-    a = np.linalg.solve(m, np.concatenate([np.stack([d.k0 for d in designs]), np.stack([d.k1 for d in designs])], -1))
-    n = m.shape[-1]
-    return [Problem(True, 0.0, float(d.thrust_max), n_scan, n, n, np.ascontiguousarray(a[i, :, :n]),
-                    np.ascontiguousarray(a[i, :, n:]), np.diag(d.mass).copy()) for i, d in enumerate(designs)]
+    a0, a1 = np.moveaxis(np.linalg.solve(m[:, None], np.stack([[d.k0, d.k1] for d in designs])), 1, 0)
+    weights = np.diagonal(m, axis1=1, axis2=2)
+    t_max = np.array([d.thrust_max for d in designs], dtype=float)
+    if vectorized:
+        return solve_affine(a0, a1, weights, t_max, n_scan=n_scan)
+    parts = [solve_affine(a0[i:i + 1], a1[i:i + 1], weights[i:i + 1], t_max[i:i + 1], n_scan=n_scan)
+             for i in range(len(designs))]
+    return _joined(parts)
+
+
+def _joined(parts: list[StackOutcome]) -> StackOutcome:
+    """Stack outcomes of consecutive parts as one."""
+    arrays = {f: np.concatenate([getattr(r, f) for r in parts])
+              for f in ("load", "kind", "omega", "participation", "evaluations", "decompositions", "pairs")}
+    return StackOutcome(warnings=[w for r in parts for w in r.warnings], **arrays)
+
+
+def _mode_names(participation: Array) -> list[str]:
+    """The dofs with at least 5 % of the kinetic energy, comma-separated, for each row."""
+    bits = (participation >= PARTICIPATION_THRESHOLD) @ (1 << np.arange(participation.shape[-1]))
+    names = {b: ",".join(n for i, n in enumerate(DOF_NAMES) if b >> i & 1) for b in np.unique(bits).tolist()}
+    return [names[b] for b in bits.tolist()]
 
 
 def critical_thrust_batch(
@@ -67,20 +85,33 @@ def critical_thrust_batch(
     problems: list[Problem] = []
     owner: list[tuple[int, bool]] = []
     done: dict[int, tuple] = {}
+    affine_evaluations = decompositions = pairs = 0
     affine = [i for i, m in enumerate(models) if isinstance(m, AffineDesign)]
     if affine:
         for i in affine:
             out["t_max"][i], out["operating"][i] = models[i].thrust_max, models[i].operating
+        rows, stack = affine, None
         try:
-            problems += _affine_problems([models[i] for i in affine], n_scan)
-            owner += [(i, True) for i in affine]
+            stack = _affine_stack([models[i] for i in affine], n_scan, vectorized)
         except np.linalg.LinAlgError:  # a singular mass somewhere: design by design
+            rows, parts = [], []
             for i in affine:
                 try:
-                    problems += _affine_problems([models[i]], n_scan)
-                    owner.append((i, True))
+                    parts.append(_affine_stack([models[i]], n_scan, True))
+                    rows.append(i)
                 except Exception as exc:  # noqa: BLE001 - reported per design
                     status[i], message[i] = _failure(exc)
+            if parts:
+                stack = _joined(parts)
+        if stack is not None:
+            idx = np.array(rows)
+            out["thrust"][idx], out["omega"][idx], kind[idx] = stack.load, stack.omega, stack.kind
+            out["undamped"][idx], ukind[idx] = stack.load, stack.kind
+            status[idx] = 0
+            for i, names, warn in zip(rows, _mode_names(stack.participation), stack.warnings):
+                modes[i], message[i] = names, "; ".join(warn)
+            affine_evaluations = int(stack.evaluations.sum())
+            decompositions, pairs = int(stack.decompositions.sum()), int(stack.pairs.sum())
     for i, model in enumerate(models):
         if model is None or isinstance(model, AffineDesign):
             continue
@@ -100,7 +131,7 @@ def critical_thrust_batch(
             problems.append(problem)
             owner.append((i, damped))
     if vectorized:
-        outcomes = solve(problems, chunk=chunk)
+        outcomes = solve(problems, chunk=chunk) if problems else []
     else:
         outcomes = [solve([p], chunk=chunk)[0] for p in problems]
     pairs: dict[int, dict[bool, object]] = {}
@@ -127,10 +158,10 @@ def critical_thrust_batch(
         kind[i], modes[i] = KINDS.index(k), ",".join(_modes(part))
         up, uk = (p, k) if und is None else und
         out["undamped"][i], ukind[i] = (np.nan if up is None else up), KINDS.index(uk)
-    evaluations = sum(r.evaluations for r in outcomes)
+    evaluations = sum(r.evaluations for r in outcomes) + affine_evaluations
     return BatchCriticalThrust(
         out["thrust"], kind, out["omega"], out["undamped"], ukind, out["t_max"], out["operating"],
-        modes, status, message, evaluations,
+        modes, status, message, evaluations, decompositions, pairs,
     )
 
 

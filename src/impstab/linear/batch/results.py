@@ -66,6 +66,9 @@ class BatchCriticalThrust:
         Empty when ``status`` is 0, else a one-line reason.
     evaluations : int
         Eigenproblems solved in total.
+    decompositions, pair_problems : int
+        Of those, the designs given by their matrices (:class:`AffineDesign`) solved with
+        eigenvectors, and with the right and left vectors of two eigenvalues only.
     """
 
     thrust: Array
@@ -79,6 +82,8 @@ class BatchCriticalThrust:
     status: NDArray[np.int8]
     message: list[str]
     evaluations: int = 0
+    decompositions: int = 0
+    pair_problems: int = 0
 
     @property
     def frequency_hz(self) -> Array:

@@ -13,10 +13,11 @@ One implementation serves a single model (a stack of one), the generic
 """
 
 from .problems import Problem, first_order_problem, second_order_problem
-from .solve import Crossing, Outcome, solve
+from .solve import Crossing, Outcome, StackOutcome, solve, solve_affine
 from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
 
 __all__ = [
-    "Problem", "first_order_problem", "second_order_problem", "Crossing", "Outcome", "solve",
+    "Problem", "first_order_problem", "second_order_problem", "Crossing", "Outcome", "StackOutcome", "solve",
+    "solve_affine",
     "FLOOR", "TOL_CLUSTER", "TOL_DUPLICATE", "TOL_MARGINAL", "TOL_UNSTABLE",
 ]

@@ -16,9 +16,11 @@ Results:
   2 divergence, 3 a limit point still to be located), :data:`OMEGA`, :data:`DIRECTION` (+1 loss,
   -1 gain), :data:`WARNED` (1: located on the classification only), :data:`LO`, :data:`HI` (the
   bracket: stable end, unstable end);
-* ``counts (J, 6)``: :data:`FIRST` (the bracket of the first loss, -1: none), :data:`EVALUATIONS`,
-  :data:`BISECTIONS`, :data:`BRACKETS`, :data:`STATUS` (1: the provider raised),
-  :data:`START_UNSTABLE` (1: unstable at ``p_min``; its onset values in row 0);
+* ``counts (J, 8)``: :data:`FIRST` (the bracket of the first loss, -1: none), :data:`EVALUATIONS`
+  (eigenproblems solved), :data:`BISECTIONS`, :data:`BRACKETS`, :data:`STATUS` (1: the provider
+  raised), :data:`START_UNSTABLE` (1: unstable at ``p_min``; its onset values in row 0), and
+  among the eigenproblems :data:`DECOMPOSITIONS` (with eigenvectors) and :data:`PAIRS` (right
+  and left vectors of two eigenvalues, by inverse iteration);
 * ``mode (J, n_dof)`` complex and ``part (J, n_dof)``: mode and participation of the first loss.
 """
 
@@ -30,4 +32,4 @@ Jobs = namedtuple("Jobs", "ints span grids a0 a1 order starts nblocks weights")
 
 FORM, AFFINE, KEY, N_SCAN, CHUNK, LARGEST = 0, 1, 2, 3, 4, 5
 LOAD, KIND, OMEGA, DIRECTION, WARNED, LO, HI = 0, 1, 2, 3, 4, 5, 6
-FIRST, EVALUATIONS, BISECTIONS, BRACKETS, STATUS, START_UNSTABLE = 0, 1, 2, 3, 4, 5
+FIRST, EVALUATIONS, BISECTIONS, BRACKETS, STATUS, START_UNSTABLE, DECOMPOSITIONS, PAIRS = 0, 1, 2, 3, 4, 5, 6, 7

@@ -33,7 +33,7 @@ from numba import njit
 
 from ..classify import _masks
 from ..participation import participation_into
-from .layout import (AFFINE, BISECTIONS, BRACKETS, DIRECTION, EVALUATIONS, FIRST, FORM, HI, KEY, KIND, LO, LOAD,
+from .layout import (AFFINE, BISECTIONS, BRACKETS, DECOMPOSITIONS, DIRECTION, EVALUATIONS, FIRST, FORM, HI, KEY, KIND, LO, LOAD,
                      OMEGA, START_UNSTABLE, STATUS, WARNED)
 from .scan import _classify
 from .spectra import FAILED, NOT_FINITE, OK, PROVIDER_ERROR, cache_new, provided_weights, spectrum, workspace
@@ -47,13 +47,13 @@ _EPS4 = 4.0 * EPS
 
 
 # -- the cluster ------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _relative_real(v):
     mag = abs(v)
     return v.real / mag if mag > 0 else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def unstable_cluster(vals, undamped, members, cplx, neg):
     """The cluster that is unstable into the mask ``members``; returns ``(found, unique, divergence)``.
 
@@ -103,7 +103,7 @@ def unstable_cluster(vals, undamped, members, cplx, neg):
     return True, unique, divergence
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def projector(vecs, inv, members, vc, wc):
     """The cluster's oblique projector ``V_C W_C^H`` as ``vc (n, k)``, ``wc (k, n)``; returns ``k``."""
     n = vecs.shape[0]
@@ -117,7 +117,7 @@ def projector(vecs, inv, members, vc, wc):
     return k
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def select(vecs, vc, wc, k, sel, share):
     """The ``k`` eigenvectors lying most in the cluster subspace into ``sel[:k]``; whether clear.
 
@@ -145,7 +145,7 @@ def select(vecs, vc, wc, k, sel, share):
     return share[order[k - 1]] > 0.25 and (n == k or share[order[k]] < 0.25)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _pair_growth(v, k):
     """Largest real part of a cluster (upper half plane), from its symmetric functions.
 
@@ -171,7 +171,7 @@ def _pair_growth(v, k):
     return c.real + abs(np.sqrt(d).real)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, derivative, sel, share, coalesce=False):
     """``(f, df, clear)``: the exact indicator of the cluster in the decomposition, its derivative.
 
@@ -249,7 +249,7 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
 
 
 # -- roots, as steps (reverse communication) ------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def newton_step(st, p, f, df):
     """Bracketed Newton (bisection guard) after ``f, df`` at ``p``; returns ``(next, done)``.
 
@@ -279,7 +279,7 @@ def newton_step(st, p, f, df):
     return new, quadratic and (step / (prev * prev)) * step * step <= EPS * abs(new)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def brent_step(st, f):
     """scipy's ``brentq`` (xtol 1e-300, rtol 4 eps) as steps; returns ``(x, done)``.
 
@@ -323,7 +323,7 @@ def brent_step(st, f):
 
 
 # -- onset values -------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def onset_values(vals, vecs, members, k, undamped, divergence, shapes, values, weights, mode, part, coalesce=False):
     """Kind and omega of the onset, its mode (largest component 1) and participation.
 
@@ -370,7 +370,7 @@ def onset_values(vals, vecs, members, k, undamped, divergence, shapes, values, w
     return (DIVERGENCE if divergence else FLUTTER), omega
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _take(vals, vecs, cols, k, n):
     """``(vecs[:n, cols[:k]], vals[cols[:k]])``, new arrays."""
     shapes = np.empty((n, k), dtype=np.complex128)
@@ -383,7 +383,7 @@ def _take(vals, vecs, cols, k, n):
 
 
 # -- every bracket of every problem ---------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def refine_stack(jobs, onsets, mode_out, part_out, counts):
     """Refine every bracket of every problem: the onsets into ``onsets``, the first loss's mode
     and participation into ``mode_out``, ``part_out`` (:mod:`impstab.linear.engine.layout`).
@@ -410,12 +410,12 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
     part = np.empty(n_dof)
     point = np.zeros(1)
     st = np.zeros(8)
-    ev = np.zeros(1, dtype=np.int64)
+    ev = np.zeros(3, dtype=np.int64)
     for j in range(len(jobs.ints)):
         if counts[j, STATUS] != 0:
             continue
         cache[0][:] = np.nan
-        ev[0] = 0
+        ev[:] = 0
         undamped = jobs.ints[j, FORM] == 0
         affine = jobs.ints[j, AFFINE] == 1
         start_unstable = counts[j, START_UNSTABLE] == 1
@@ -641,6 +641,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 mode_out[j, :] = mode
                 part_out[j, :] = part
         counts[j, EVALUATIONS] += ev[0]
+        counts[j, DECOMPOSITIONS] += ev[1]
         counts[j, FIRST] = first
         if failed:
             counts[j, STATUS] = 1

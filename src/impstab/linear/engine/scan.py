@@ -26,7 +26,7 @@ from numba import njit, objmode
 
 from ..classify import _indicators, _masks
 from ..small_eigvec import _eigvector
-from .layout import BRACKETS, CHUNK, EVALUATIONS, FORM, HI, LO, N_SCAN, START_UNSTABLE, STATUS
+from .layout import BRACKETS, CHUNK, DECOMPOSITIONS, EVALUATIONS, FORM, HI, LO, N_SCAN, PAIRS, START_UNSTABLE, STATUS
 from .spectra import OK, PROVIDER_ERROR, cache_new, operators_at, spectrum, workspace
 from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
 
@@ -37,7 +37,7 @@ _GOLDEN = 0.5 * (3.0 - float(np.sqrt(5.0)))
 _MAXFUN = 500
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _classify(vals, lost, undamped, flags, ind, cplx, neg):
     """Stability flags and the bubble indicators ``(m, 2)`` from the eigenvalues ``vals (m, N)``.
 
@@ -54,7 +54,7 @@ def _classify(vals, lost, undamped, flags, ind, cplx, neg):
 
 # -- scipy's bounded Brent minimisation, as steps (reverse communication) ------------------------
 # state: a, b, fulc, nfc, xf, rat, e, fx, ffulc, fnfc, num, xatol, x, phase, xm, tol1, tol2
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def fmin_start(st, x1, x2, xatol):
     """Start ``_minimize_scalar_bounded`` on ``(x1, x2)``; returns the first point to evaluate."""
     st[0], st[1] = x1, x2
@@ -67,7 +67,7 @@ def fmin_start(st, x1, x2, xatol):
     return st[12]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def fmin_next(st, f):
     """Give ``f`` at the last point; returns ``(next point, more)`` (``more`` False: done)."""
     a, b, fulc, nfc, xf, rat, e, fx, ffulc, fnfc, num, xatol = st[0], st[1], st[2], st[3], st[4], st[5], st[6], \
@@ -138,7 +138,7 @@ def _lapack_complex_eigvals(a, out):
     out[...] = np.linalg.eigvals(a)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _complex_eigvals(a, out):
     """Eigenvalues of a small complex matrix: closed forms up to order 2, else LAPACK."""
     k = a.shape[0]
@@ -155,7 +155,7 @@ def _complex_eigvals(a, out):
             _lapack_complex_eigvals(a, out)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def closest_pair(vals, lower, upper):
     """The closest pair of distinct real ``s`` as masks ``lower``, ``upper`` (their duplicates in).
 
@@ -188,7 +188,7 @@ def closest_pair(vals, lower, upper):
     return 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _pulled(inter, rate):
     """Whether an interaction eigenvalue pulls the pair together (below -1e-8 |rate|^2)."""
     norm = 1e-300
@@ -200,7 +200,7 @@ def _pulled(inter, rate):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def attraction(vals, vecs, inv, lower, upper, rate):
     """Whether the pair ``lower``, ``upper`` can merge, from a full decomposition ``vals, vecs, inv``.
 
@@ -235,7 +235,7 @@ def attraction(vals, vecs, inv, lower, upper, rate):
     return _pulled(inter, rate)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def simple_attraction(op, s_low, s_up, rate, w):
     """:func:`attraction` for two simple eigenvalues, from four inverse iterations (no decomposition).
 
@@ -272,7 +272,7 @@ def simple_attraction(op, s_low, s_up, rate, w):
 
 
 # -- the scan of every problem --------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def scan_stack(jobs, all_crossings, onsets, counts):
     """The brackets of every problem into ``onsets[j, :, LO:HI + 1]`` (stable load, unstable load).
 
@@ -303,10 +303,10 @@ def scan_stack(jobs, all_crossings, onsets, counts):
     upper = np.empty(n, dtype=np.bool_)
     pair_ws = (np.empty((n, n)), np.empty((n, n)), np.empty(n, dtype=np.int64), np.empty(n), np.empty(n),
                np.empty(n), np.empty(n))
-    counter = np.zeros(1, dtype=np.int64)
+    counter = np.zeros(3, dtype=np.int64)
     for j in range(count):
         cache[0][:] = np.nan  # a new problem: nothing cached
-        counter[0] = 0
+        counter[:] = 0
         npts = jobs.ints[j, N_SCAN] + 1
         grid = jobs.grids[j, :npts]
         chunk = max(jobs.ints[j, CHUNK], 1)
@@ -370,6 +370,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                                 s_up = vals_grid[jj, np.argmax(upper)].real
                                 pull = simple_attraction(ops3[1], s_low, s_up, rate, pair_ws)
                                 counter[0] += 1
+                                counter[2] += 1
                             if pull < 0:  # repeated eigenvalues, or no inverse iteration: decompose
                                 code, s = spectrum(jobs, j, grid[jj:jj + 1], True, cache, ws, counter)
                                 if code == PROVIDER_ERROR:
@@ -409,6 +410,8 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                 break
             jj += 1
         counts[j, EVALUATIONS] += counter[0]
+        counts[j, DECOMPOSITIONS] += counter[1]
+        counts[j, PAIRS] += counter[2]
         counts[j, STATUS] = 1 if failed else 0
         counts[j, START_UNSTABLE] = 1 if (flags[0] and not failed) else 0
         counts[j, BRACKETS] = 0 if (failed or flags[0]) else found

@@ -10,8 +10,8 @@ from numpy.typing import NDArray
 
 from ..blocks import decoupled_blocks
 from ..eigen import kinetic_shares
-from .layout import (AFFINE, BISECTIONS, BRACKETS, DIRECTION, EVALUATIONS, FIRST, HI, KIND, LARGEST, LO, LOAD,
-                     N_SCAN, OMEGA, START_UNSTABLE, STATUS, WARNED, Jobs)
+from .layout import (AFFINE, BISECTIONS, BRACKETS, CHUNK, DECOMPOSITIONS, DIRECTION, EVALUATIONS, FIRST, HI, KIND, LARGEST, LO,
+                     LOAD, N_SCAN, OMEGA, PAIRS, START_UNSTABLE, STATUS, WARNED, Jobs)
 from .refine import LIMIT, refine_stack
 from .scan import scan_stack
 from . import large
@@ -19,12 +19,19 @@ from .problems import Problem
 from .spectra import register, unregister
 from .tolerances import TOL_UNSTABLE
 
-__all__ = ["Outcome", "Crossing", "solve", "PROVIDER_CHUNK"]
+__all__ = ["Outcome", "Crossing", "StackOutcome", "solve", "solve_affine", "PROVIDER_CHUNK"]
 
 Array = NDArray[np.float64]
 
-#: scan points classified per call of a provider (affine problems: one at a time)
+#: scan points classified per call of a provider
 PROVIDER_CHUNK = 16
+#: scan points classified per call for affine problems whose blocks are closed forms (order <= 2),
+#: where the call costs more than the eigenvalues; coupled affine problems go one point at a time
+BLOCK_CHUNK = 8
+
+
+def _affine_chunk(largest):
+    return np.where(largest <= 2, BLOCK_CHUNK, 1)
 
 _KINDS = {1: "flutter", 2: "divergence"}
 
@@ -92,6 +99,7 @@ def _jobs(problems: list[Problem], chunk: int) -> tuple[Jobs, list[int]]:
             weights = np.stack([p.weights for p in problems])
         bs = decoupled_blocks(a0, a1, np.array([max(abs(p.p_min), abs(p.p_max)) for p in problems]))
         ints[:, LARGEST] = bs.largest
+        ints[:, CHUNK] = _affine_chunk(bs.largest)
         return Jobs(ints, span, grids, a0, a1, bs.order, bs.starts, bs.nblocks, weights), []
     a0 = np.zeros((count, n, n))
     a1 = np.zeros((count, n, n))
@@ -108,7 +116,79 @@ def _jobs(problems: list[Problem], chunk: int) -> tuple[Jobs, list[int]]:
     if rows.size:
         bs = decoupled_blocks(a0[rows], a1[rows], np.abs(span[rows]).max(axis=1))
         order[rows], starts[rows], nblocks[rows], ints[rows, LARGEST] = bs.order, bs.starts, bs.nblocks, bs.largest
+        ints[rows, CHUNK] = _affine_chunk(bs.largest)
     return Jobs(ints, span, grids, a0, a1, order, starts, nblocks, weights), [k for k in keys if k >= 0]
+
+
+def _run(jobs: Jobs, n_dof: int, all_crossings: bool):
+    """The two compiled loops over a stack: ``(onsets, counts, mode, part)`` (see ``layout``)."""
+    count = len(jobs.ints)
+    onsets = np.full((count, 2 * jobs.grids.shape[1], 7), np.nan)
+    counts = np.zeros((count, 8), dtype=np.int64)
+    mode = np.zeros((count, n_dof), dtype=np.complex128)
+    part = np.zeros((count, n_dof))
+    scan_stack(jobs, bool(all_crossings), onsets, counts)
+    refine_stack(jobs, onsets, mode, part, counts)
+    return onsets, counts, mode, part
+
+
+@dataclass(frozen=True, eq=False)
+class StackOutcome:
+    """The first loss of stability of every problem of an affine stack, as arrays.
+
+    ``load``, ``omega`` (NaN: stable up to ``p_max``), ``kind`` (0 none, 1 flutter,
+    2 divergence), ``participation (J, n_dof)``, ``evaluations (J,)`` eigenproblems, and
+    ``warnings``: the warnings of each problem (mostly empty). ``decompositions`` and ``pairs``
+    count the eigenproblems with eigenvectors, and those with the vectors of two eigenvalues only.
+    """
+
+    load: Array
+    kind: NDArray[np.int8]
+    omega: Array
+    participation: Array
+    evaluations: NDArray[np.int64]
+    warnings: list[tuple[str, ...]]
+    decompositions: NDArray[np.int64] | None = None
+    pairs: NDArray[np.int64] | None = None
+
+
+def solve_affine(a0: Array, a1: Array, weights: Array, p_max: Array, *, undamped: bool = True,
+                 n_scan: int = 64) -> StackOutcome:
+    """The engine on a stack of affine problems given as arrays (a design study's designs).
+
+    ``a0, a1 (J, N, N)``: the operators ``A = a0 + p a1`` (undamped: ``M^-1 K``); ``weights
+    (J, n_dof)``; ``p_max (J,)``: each range ``[0, p_max]``. The same loops as :func:`solve`,
+    without a Python object per problem.
+    """
+    count, n = a0.shape[0], a0.shape[-1]
+    p_max = np.asarray(p_max, dtype=float)
+    ints = np.empty((count, 6), dtype=np.int64)
+    ints[:] = (0 if undamped else 1, 1, -1, n_scan, 1, n)
+    span = np.zeros((count, 2))
+    span[:, 1] = p_max
+    grids = np.empty((count, n_scan + 1))
+    for value in np.unique(p_max):
+        grids[p_max == value] = _grid(0.0, float(value), n_scan)
+    a0, a1 = np.ascontiguousarray(a0, dtype=float), np.ascontiguousarray(a1, dtype=float)
+    bs = decoupled_blocks(a0, a1, np.abs(p_max))
+    ints[:, LARGEST] = bs.largest
+    ints[:, CHUNK] = _affine_chunk(bs.largest)
+    jobs = Jobs(ints, span, grids, a0, a1, bs.order, bs.starts, bs.nblocks, np.ascontiguousarray(weights, dtype=float))
+    onsets, counts, mode, part = _run(jobs, weights.shape[-1], False)
+    rows = np.arange(count)
+    start = counts[:, START_UNSTABLE] == 1
+    first = np.where(start, 0, counts[:, FIRST])
+    found = first >= 0
+    pick = onsets[rows, np.maximum(first, 0)]
+    load = np.where(found, pick[:, LOAD], np.nan)
+    omega = np.where(found, pick[:, OMEGA], np.nan)
+    kind = np.where(found, pick[:, KIND], 0).astype(np.int8)
+    warned = np.flatnonzero((onsets[:, :, WARNED] == 1).any(axis=1))
+    warnings: list[tuple[str, ...]] = [()] * count
+    for r in warned:
+        warnings[r] = tuple(_warning(float(row[LOAD])) for row in onsets[r, : counts[r, BRACKETS]] if row[WARNED])
+    return StackOutcome(load, kind, omega, part, counts[:, EVALUATIONS].copy(), warnings,
+                        counts[:, DECOMPOSITIONS].copy(), counts[:, PAIRS].copy())
 
 
 def solve(problems: list[Problem], *, all_crossings: bool = False, chunk: int = PROVIDER_CHUNK) -> list[Outcome]:
@@ -130,14 +210,8 @@ def solve(problems: list[Problem], *, all_crossings: bool = False, chunk: int = 
     for (n, n_dof), members in groups.items():
         group = [problems[i] for i in members]
         jobs, keys = _jobs(group, int(chunk))
-        count = len(group)
-        onsets = np.full((count, 2 * jobs.grids.shape[1], 7), np.nan)
-        counts = np.zeros((count, 6), dtype=np.int64)
-        mode = np.zeros((count, n_dof), dtype=np.complex128)
-        part = np.zeros((count, n_dof))
         try:
-            scan_stack(jobs, bool(all_crossings), onsets, counts)
-            refine_stack(jobs, onsets, mode, part, counts)
+            onsets, counts, mode, part = _run(jobs, n_dof, all_crossings)
         finally:
             for k in keys:
                 unregister(k)

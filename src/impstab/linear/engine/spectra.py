@@ -99,14 +99,14 @@ def _lapack_eig(op, vals, vecs, inv):
 
 
 # -- compiled ----------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _provided_operators(key, loads, out):
     with objmode(status="int64"):
         status = _bridge_operators(key, loads, out)
     return status
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def provided_weights(key, p, out):
     """Participation weights at ``p`` from the provider ``key``; 0, or 1 when it raised."""
     with objmode(status="int64"):
@@ -114,20 +114,20 @@ def provided_weights(key, p, out):
     return status
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _lapack_values(op, out):
     with objmode():
         _lapack_eigvals(op, out)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _lapack_vectors(op, vals, vecs, inv):
     with objmode(status="int64"):
         status = _lapack_eig(op, vals, vecs, inv)
     return status
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def workspace(n, chunk):
     """Work arrays of :func:`spectrum` for operators of order ``n``, up to ``chunk`` loads a call."""
     order = np.arange(n).reshape(1, n)
@@ -139,7 +139,7 @@ def workspace(n, chunk):
             np.empty((chunk, n), dtype=np.complex128), np.empty(chunk, dtype=np.bool_))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cache_new(n):
     """Decompositions at up to :data:`SLOTS` loads: load, status, values, vectors, inverse, age, clock."""
     return (np.full(SLOTS, np.nan), np.zeros(SLOTS, dtype=np.int64), np.empty((SLOTS, n), dtype=np.complex128),
@@ -147,7 +147,7 @@ def cache_new(n):
             np.zeros(SLOTS, dtype=np.int64), np.zeros(1, dtype=np.int64))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _finite(a):
     for x in a.flat:
         if not np.isfinite(x):
@@ -155,7 +155,7 @@ def _finite(a):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def operators_at(jobs, j, loads, out):
     """``out[i] = A_j(loads[i])``; returns 0, or 1 when the provider failed."""
     if jobs.ints[j, AFFINE]:
@@ -169,7 +169,7 @@ def operators_at(jobs, j, loads, out):
     return _provided_operators(jobs.ints[j, KEY], loads, out)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _values_of(op, ws, out):
     """Eigenvalues of the real matrix ``op`` into ``out``: compiled QR, else LAPACK."""
     n = op.shape[0]
@@ -181,7 +181,7 @@ def _values_of(op, ws, out):
     _lapack_values(op, out)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     """Eigenvalues or a decomposition of problem ``j``; returns ``(status, slot)``.
 
@@ -192,7 +192,7 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     ``vectors`` True: the decomposition at ``loads[0]`` (values, unit eigenvectors, their
     inverse) in cache slot ``slot``, computed unless cached; the status (:data:`OK`,
     :data:`FAILED`, :data:`NOT_FINITE`, :data:`PROVIDER_ERROR`) is also ``cache[1][slot]``.
-    ``ev[0]`` counts the eigenproblems solved.
+    ``ev[0]`` counts the eigenproblems solved, ``ev[1]`` the decompositions among them.
     """
     m = len(loads)
     n = jobs.a0.shape[1]
@@ -238,6 +238,7 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     c_age[s] = clock[0]
     vals, vecs, inv = c_vals[s], c_vecs[s], c_inv[s]
     ev[0] += 1
+    ev[1] += 1
     if compiled and block_eig_at(jobs.a0, jobs.a1, j, p, jobs.order, jobs.starts, jobs.nblocks, vals, vecs, inv,
                                  ws[0]):
         c_status[s] = OK
