@@ -169,7 +169,7 @@ def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: in
     p_min, p_max, n_scan = _range(family, p_min, p_max, n_scan)
     parts = family.affine_parts() if hasattr(family, "affine_parts") else None
     if parts is not None:
-        parts = tuple(np.asarray(x, dtype=float) for x in parts)
+        parts = [np.asarray(x, dtype=float) for x in parts]
         d, g = parts[1], parts[2]
     else:
         _, d, g, _ = family.matrices(np.array([p_min, 0.5 * (p_min + p_max), p_max]))

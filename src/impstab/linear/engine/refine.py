@@ -250,6 +250,44 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
 
 # -- roots, as steps (reverse communication) ------------------------------------------------------
 @njit(cache=True, error_model="numpy")
+def hermite_root(a, b, fa, fb, da, db):
+    """A first point for Newton: the root in ``(a, b)`` of the cubic with ``f`` and ``f'`` at both ends.
+
+    Its error is of order ``h^4`` against the secant's ``h^2``; the secant point where the slopes
+    are not known or the cubic has no root inside.
+    """
+    secant = a - fa * (b - a) / (fb - fa)
+    if np.isnan(da) or np.isnan(db):
+        return secant
+    h = b - a
+    # the cubic in t = (x - a) / h with value and slope (times h) at t = 0 and 1
+    c0, c1 = fa, da * h
+    c2 = 3 * (fb - fa) - (2 * da + db) * h
+    c3 = 2 * (fa - fb) + (da + db) * h
+    t = (secant - a) / h
+    lo, hi = 0.0, 1.0
+    for _ in range(30):  # safeguarded Newton on the cubic (a few scalar steps)
+        f = c0 + t * (c1 + t * (c2 + t * c3))
+        if f == 0.0:
+            break
+        if (f > 0) == (fa > 0):
+            lo = t
+        else:
+            hi = t
+        d = c1 + t * (2 * c2 + 3 * t * c3)
+        step = f / d if d != 0.0 else np.inf
+        new = t - step
+        if not (lo < new < hi):
+            new = 0.5 * (lo + hi)
+        if abs(new - t) <= 1e-15:
+            t = new
+            break
+        t = new
+    x = a + t * h
+    return x if min(a, b) < x < max(a, b) else secant
+
+
+@njit(cache=True, error_model="numpy")
 def newton_step(st, p, f, df):
     """Bracketed Newton (bisection guard) after ``f, df`` at ``p``; returns ``(next, done)``.
 
@@ -503,7 +541,9 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 # is where it is off the axis by TOL_UNSTABLE
                                 target = TOL_UNSTABLE
                             coalesce = marginal and not divergence
+                        newton = affine and target == 0.0 and (undamped or k <= 2 or coalesce)
                         fab = np.zeros(2)
+                        dfab = np.full(2, np.nan)
                         clear = True
                         for e in range(2):
                             point[0] = a if e == 0 else b
@@ -511,10 +551,13 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                             if code == PROVIDER_ERROR:
                                 failed = True
                                 break
-                            f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
-                                                 divergence, target, False, sel, share, coalesce)
+                            slope = newton and code == OK
+                            f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
+                                                  divergence, target, slope, sel, share, coalesce)
                             clear = clear and code != NOT_FINITE and ok
                             fab[e] = f
+                            if slope:
+                                dfab[e] = df
                         if failed or not clear:
                             break
                         fa, fb = fab[0], fab[1]
@@ -523,9 +566,9 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         elif np.sign(fa) == np.sign(fb):
                             step_back = True
                             break
-                        elif affine and target == 0.0 and (undamped or k <= 2 or coalesce):
+                        elif newton:
                             st[0], st[1], st[2], st[3] = a, b, fa, np.nan
-                            p = a - fa * (b - a) / (fb - fa)
+                            p = hermite_root(a, b, fa, fb, dfab[0], dfab[1])
                             for _ in range(100):
                                 point[0] = last = p
                                 code, s = spectrum(jobs, j, point, True, cache, ws, ev)

@@ -80,6 +80,17 @@ def _grid(p_min: float, p_max: float, n_scan: int) -> Array:
 def _jobs(problems: list[Problem], chunk: int) -> tuple[Jobs, list[int]]:
     """The stack's arrays (:mod:`~impstab.linear.engine.layout`) and the providers' keys."""
     count = len(problems)
+    if count == 1 and problems[0].affine:  # a single model: the fewest calls
+        p = problems[0]
+        a0, a1 = p.operators()
+        a0, a1 = a0[None], a1[None]
+        bs = decoupled_blocks(a0, a1, np.array([max(abs(p.p_min), abs(p.p_max))]))
+        largest = int(bs.largest[0])
+        ints = np.array([[0 if p.undamped else 1, 1, -1, p.n_scan, BLOCK_CHUNK if largest <= 2 else 1, largest]],
+                        dtype=np.int64)
+        grids = _grid(p.p_min, p.p_max, p.n_scan)[None].copy()
+        return Jobs(ints, np.array([[p.p_min, p.p_max]]), grids, a0, a1, bs.order, bs.starts, bs.nblocks,
+                    p.weights[None]), []
     n, n_dof = problems[0].order, problems[0].n_dof
     keys = [-1 if p.affine else register(p.provider) for p in problems]
     ints = np.array([(0 if p.undamped else 1, p.affine, k, p.n_scan, 1 if p.affine else chunk, n)
