@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 from ...model.model import DOF_NAMES, Model
 from ..critical_thrust import PARTICIPATION_THRESHOLD, _modes
 from ..engine import Problem, StackOutcome, second_order_problem, solve, solve_affine
+from ..engine.problems import mass_solve
 from ..linearize import ModelFamily
 from .results import KINDS, STATUSES, AffineDesign, BatchCriticalThrust
 
@@ -27,7 +28,7 @@ def _single(model: Model) -> tuple:
 def _affine_stack(designs: list[AffineDesign], n_scan: int, vectorized: bool):
     """The undamped problems ``M^-1 K0 + T M^-1 K1`` of designs given by their matrices, solved at once."""
     m = np.stack([d.mass for d in designs])
-    a0, a1 = np.moveaxis(np.linalg.solve(m[:, None], np.stack([[d.k0, d.k1] for d in designs])), 1, 0)
+    a0, a1 = np.moveaxis(mass_solve(m, np.stack([[d.k0, d.k1] for d in designs])), 1, 0)
     weights = np.diagonal(m, axis1=1, axis2=2)
     t_max = np.array([d.thrust_max for d in designs], dtype=float)
     if vectorized:

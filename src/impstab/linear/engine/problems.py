@@ -21,10 +21,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from numba import njit
+
 from ..eigen import state_matrices
+from ..small_eigvec import _lu, _lu_solve
 from .large import LARGE_ORDER
 
-__all__ = ["Problem", "second_order_problem", "first_order_problem"]
+__all__ = ["Problem", "second_order_problem", "first_order_problem", "mass_solve"]
 
 Array = NDArray[np.float64]
 
@@ -79,8 +82,42 @@ class Problem:
         """``(a0, a1)`` of an affine problem (formed from ``second_order`` when first needed)."""
         if self.a0 is None:
             m, k0, k1 = self.second_order
-            self.a0, self.a1 = np.linalg.solve(m, np.stack([k0, k1]))
+            self.a0, self.a1 = mass_solve(m[None], np.array([[k0, k1]]))[0]
         return self.a0, self.a1
+
+
+@njit(cache=True, error_model="numpy")
+def _solve_into(m, rhs, out):
+    """``out[s, r] = m[s]^-1 rhs[s, r]`` by LU with partial pivoting; False where an ``m[s]`` is singular."""
+    count, n = m.shape[0], m.shape[1]
+    b = np.empty((n, n))
+    piv = np.empty(n, dtype=np.int64)
+    x = np.empty(n)
+    for s in range(count):
+        b[:, :] = m[s]
+        if _lu(b, n, piv, 0.0):
+            return False
+        for r in range(rhs.shape[1]):
+            for c in range(n):
+                for i in range(n):
+                    x[i] = rhs[s, r, i, c]
+                _lu_solve(b, n, piv, x)
+                for i in range(n):
+                    out[s, r, i, c] = x[i]
+    return True
+
+
+def mass_solve(m: Array, rhs: Array) -> Array:
+    """``m^-1 rhs`` for stacks ``m (J, n, n)``, ``rhs (J, r, n, n)``: compiled, one call for a batch.
+
+    The operators of affine problems (``M^-1 K0``, ``M^-1 K1``; ``E^-1 A0``, ``E^-1 A1``) come from
+    here, for one model and for a design study alike. Raises ``numpy.linalg.LinAlgError`` for a
+    singular matrix.
+    """
+    out = np.empty(rhs.shape)
+    if not _solve_into(np.ascontiguousarray(m, dtype=float), np.ascontiguousarray(rhs, dtype=float), out):
+        raise np.linalg.LinAlgError("Singular matrix")
+    return out
 
 
 class _SecondOrderProvider:
@@ -181,7 +218,7 @@ def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: in
                        provider=_SecondOrderProvider(family, bool(undamped)))
     m, d, g, k0, k1 = parts
     if undamped:
-        problem = Problem(True, p_min, p_max, n_scan, n, n, weights=np.diag(m).copy(), second_order=(m, k0, k1))
+        problem = Problem(True, p_min, p_max, n_scan, n, n, weights=m.diagonal().copy(), second_order=(m, k0, k1))
         if n <= LARGE_ORDER:  # a large one may be reduced: its operators are formed only if needed
             problem.operators()
         return problem
@@ -201,7 +238,7 @@ def first_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: int
     if parts is None:
         return Problem(False, p_min, p_max, n_scan, n, n_dof, provider=_FirstOrderProvider(family))
     e, a0, a1 = (np.asarray(x, dtype=float) for x in parts)
-    a0, a1 = np.linalg.solve(e, np.stack([a0, a1]))
+    a0, a1 = mass_solve(e[None], np.array([[a0, a1]]))[0]
     weights = getattr(family, "weights", None)
     weights = np.ones(n_dof) if weights is None else np.asarray(weights, dtype=float)
     return Problem(False, p_min, p_max, n_scan, n, n_dof, a0, a1, weights.copy())

@@ -208,6 +208,15 @@ def solve(problems: list[Problem], *, all_crossings: bool = False, chunk: int = 
     Problems with operators of the same order are solved in one compiled loop; a problem whose
     provider raises gets an :class:`Outcome` with that ``error`` and the others go on.
     """
+    if len(problems) == 1 and problems[0].order <= large.LARGE_ORDER:  # one model: the fewest calls
+        p = problems[0]
+        jobs, keys = _jobs(problems, int(chunk))
+        try:
+            onsets, counts, mode, part = _run(jobs, p.n_dof, all_crossings)
+        finally:
+            for k in keys:
+                unregister(k)
+        return [_outcome(p, onsets[0], mode[0], part[0], counts[0], all_crossings)]
     outcomes: list[Outcome | None] = [None] * len(problems)
     groups: dict[tuple[int, int], list[int]] = {}
     notes: dict[int, tuple[str, ...]] = {}
@@ -296,8 +305,10 @@ def _outcome(problem: Problem, onsets, mode, part, counts, all_crossings: bool, 
             p, kind, omega = float(row[LOAD]), _KINDS[int(row[KIND])], float(row[OMEGA])
         if row[WARNED]:
             warnings.append(_warning(p))
-        found.append(Crossing(p, direction, kind, omega))
-    found.sort(key=lambda c: c.load)
+        if all_crossings or best is None:
+            found.append(Crossing(p, direction, kind, omega))
+    if len(found) > 1:
+        found.sort(key=lambda c: c.load)
     if best is None:
         return Outcome(None, "none", None, None, None, tuple(found), evaluations, tuple(warnings),
                        bisections=bisections, method=method)
