@@ -7,8 +7,9 @@ and the eigen-decomposition of the whole is that of each block: closed forms for
 and two dofs, the compiled small-matrix routines for larger ones (eigenvalues by
 :mod:`impstab.linear.small_eig`, eigenvectors by :mod:`impstab.linear.small_eigvec`); a
 coupled design is one block of six.
-Design studies solve millions of such eigenproblems, so the batched critical-thrust engine uses
-this decomposition wherever a design has it.
+Design studies solve millions of such eigenproblems, so the stability engine
+(:mod:`impstab.linear.engine`) uses this decomposition wherever a problem has it, through the
+per-design routines :func:`block_eigvals_at` and :func:`block_eig_at`.
 
 Which dofs are coupled
 ----------------------

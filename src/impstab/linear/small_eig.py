@@ -2,8 +2,8 @@
 
 LAPACK's ``geev`` spends most of its time on a 6 x 6 or 12 x 12 matrix in call overhead and
 blocking logic meant for large ones (about 2.6 us for a 6 x 6 scan operator, against 0.9 us
-here). The thrust scans of the critical-load engine classify thousands of such matrices, so
-they use this routine; eigenvectors and everything outside the scans stay with LAPACK.
+here). The stability engine classifies thousands of such matrices, so it uses this routine
+(eigenvectors come from :mod:`impstab.linear.small_eigvec`, built on it).
 
 Algorithm (the classical eigenvalue-only path of EISPACK / LAPACK ``dlahqr``):
 

@@ -12,13 +12,16 @@ only bracket. The onset itself is the root of a smooth indicator that crosses ze
   negative once it is a complex pair; divergence: the cluster mean of ``s``;
 * first-order problems (``lambda``): the largest real part of the cluster from its symmetric
   functions (``Re c + |Re sqrt(d)|`` with the mean ``c`` and variance ``d`` of the upper half, a
-  Hopf crossing). A branch that lay on the imaginary axis before (an undamped gyroscopic
-  problem) leaves it like ``sqrt(p - p_c)``; there the onset is where it is off the axis by the
-  classification tolerance, an error of the order of that tolerance squared.
+  Hopf crossing). Where the merging branches lay on the imaginary axis before (an undamped
+  system in first-order form, an undamped gyroscopic one), the discriminant of the cluster's
+  upper half, ``Re(m sum lambda^2 - (sum lambda)^2)``, which crosses zero linearly like
+  ``Delta``; a branch leaving the axis through zero leaves like ``sqrt(p - p_c)``, and its onset
+  is where it is off the axis by the classification tolerance (an error of order 1e-14).
 
 Affine problems use the exact derivative of the indicator (eigenvalue derivatives
-``W_C A1 V_C``) in a bracketed Newton iteration; the others scipy's Brent method (``brentq``,
-ported as steps). Where the cluster at ``b`` is not clearly one at ``a``, the bracket is halved
+``W_C A1 V_C``) in a bracketed Newton iteration from the root of the Hermite cubic through the
+indicator and its slope at both ends; the others scipy's Brent method (``brentq``, ported as
+steps). Where the cluster at ``b`` is not clearly one at ``a``, the bracket is halved
 on the classification and tried again; where the indicator shows ``a`` already past the onset,
 ``a`` steps back by the bracket width. Where the exact route cannot be used at all, the bracket
 is narrowed on the classification alone and the result carries a warning.
