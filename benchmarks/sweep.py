@@ -18,6 +18,9 @@ Measured in one run on this machine:
 * **coupled** -- the same measurement of sweep and loop on a layout with no decoupled blocks
   (the asymmetric example, classical linearization, over the first mount's x and shear
   stiffness), so that the figure for designs the block route cannot help is in the same line.
+  Beside it the **compiled eigenvalue floor** (:func:`eigenvalue_floor`): the time of just the
+  eigenvalue problems these designs need, with the compiled small-matrix routines, and
+  ``floor_ratio``, the sweep's time per design over it.
 * **workers** -- the same study on a local Dask cluster (``impstab.studies.execute.local_cluster``)
   of each of ``--workers-list`` worker processes (default 1, 2, 4, 8; one thread each; the
   workers write their own chunks), cluster started and warmed up (one chunk on every worker)
@@ -55,7 +58,7 @@ from pathlib import Path
 import numpy as np
 
 import impstab
-from impstab.linear.critical import _Engine
+from impstab.linear.engine import second_order_problem
 from impstab.linear.linearize import ModelFamily
 from impstab.model import model_from_dict
 from impstab.studies import load_study, run_study
@@ -91,9 +94,9 @@ def scan_operator_time(study, designs: np.ndarray, n_scan: int = 64) -> float:
         idx = np.unravel_index(j, study.shape)
         vals = [p.values[i] for p, i in zip(study.parameters, idx)]
         model = model_from_dict(variant_dict(study.base_model, [p.path.segments for p in study.parameters], vals))
-        eng = _Engine(ModelFamily(model), model.analysis.thrust_max)
+        problem = second_order_problem(ModelFamily(model), model.analysis.thrust_max)  # affine: A0 + T A1
         grid = np.linspace(0.0, model.analysis.thrust_max, n_scan + 1)
-        ops.append(eng.operators(grid)[0])
+        ops.append(problem.a0[None] + grid[:, None, None] * problem.a1[None])
     stack = np.ascontiguousarray(np.concatenate(ops))
     best = np.inf
     for _ in range(5):
@@ -117,6 +120,48 @@ def loop_time(study, designs: np.ndarray) -> float:
     return (time.perf_counter() - t0) / len(dicts)
 
 
+def eigenvalue_floor(study, designs: np.ndarray, repeat: int = 5) -> dict:
+    """The compiled eigenvalue floor of the designs: the time of just their eigenvalue problems.
+
+    The engine's own counts on these designs (bulk-assembled, as the sweep solves them): the
+    eigenproblems with eigenvectors at the compiled decomposition's time (``eig_affine``, per
+    problem on a stack of the designs' operators), every other one -- eigenvalues only, and the
+    pair vectors of the attraction test -- at the compiled eigenvalue routine's
+    (``eigvals_affine_blocks``), a lower bound for the latter. Best of ``repeat``.
+    """
+    from impstab.linear.batch import critical_thrust_batch
+    from impstab.linear.blocks import decoupled_blocks, eig_affine, eigvals_affine_blocks
+    from impstab.studies.bulk import assemble_bulk
+
+    segs = [p.path.segments for p in study.parameters]
+    idx = np.unravel_index(designs, study.shape)
+    cols = [np.asarray(p.values)[i] for p, i in zip(study.parameters, idx)]
+    bulk = assemble_bulk(study.base_model, segs, cols)
+    models = [d for d in bulk.designs if d is not None]
+    res = critical_thrust_batch(models)
+    a0 = np.stack([np.linalg.solve(d.mass, d.k0) for d in models])
+    a1 = np.stack([np.linalg.solve(d.mass, d.k1) for d in models])
+    t_max = np.array([d.thrust_max for d in models])
+    blocks = decoupled_blocks(a0, a1, t_max)
+    loads = t_max[:, None] * np.linspace(0.0, 1.0, 65)[None]
+    mid = 0.5 * t_max
+    eigvals_affine_blocks(a0, a1, loads, blocks)
+    eig_affine(a0, a1, mid, blocks)
+    t_vals = t_vecs = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        eigvals_affine_blocks(a0, a1, loads, blocks)
+        t_vals = min(t_vals, (time.perf_counter() - t0) / loads.size)
+        t0 = time.perf_counter()
+        eig_affine(a0, a1, mid, blocks)
+        t_vecs = min(t_vecs, (time.perf_counter() - t0) / len(models))
+    values_only = res.evaluations - res.decompositions
+    floor = (values_only * t_vals + res.decompositions * t_vecs) / len(models)
+    return {"floor_us_per_design": floor * 1e6, "eigenvalue_us": t_vals * 1e6, "decomposition_us": t_vecs * 1e6,
+            "eigenvalue_problems_per_design": values_only / len(models),
+            "decompositions_per_design": res.decompositions / len(models), "designs": len(models)}
+
+
 def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng) -> dict:
     """Sweep and loop on the asymmetric example (classical linearization): no decoupled blocks."""
     text = COUPLED_EXAMPLE.read_text()
@@ -129,8 +174,10 @@ def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng) -> dict:
     seconds, _ = timed_study(study, tmp / "coupled.zarr")
     subset = rng.choice(study.size, size=min(loop_sample, study.size), replace=False)
     t_loop = loop_time(study, subset)
+    floor = eigenvalue_floor(study, rng.choice(study.size, size=min(1000, study.size), replace=False))
     return {"designs_per_s": study.size / seconds, "speedup_vs_loop": t_loop * study.size / seconds,
-            "loop_us_per_design": t_loop * 1e6}
+            "loop_us_per_design": t_loop * 1e6, "eigenvalue_floor": floor,
+            "floor_ratio": seconds / study.size / (floor["floor_us_per_design"] * 1e-6)}
 
 
 def timed_study(study, store: Path, **kw) -> tuple[float, object]:
@@ -279,6 +326,11 @@ def main() -> int:
             coupled = coupled_rates(tmp, args.n, args.chunk, args.loop_sample, rng)
             print(f"coupled layout   {coupled['designs_per_s']:,.0f} designs/s, loop {coupled['loop_us_per_design']:.0f} "
                   f"us/design: {coupled['speedup_vs_loop']:.2f}x (asymmetric example, no decoupled blocks)")
+            fl = coupled["eigenvalue_floor"]
+            print(f"eigenvalue floor {fl['floor_us_per_design']:.1f} us/design: {fl['eigenvalue_problems_per_design']:.1f} "
+                  f"eigenvalue problems x {fl['eigenvalue_us']:.2f} us + {fl['decompositions_per_design']:.1f} "
+                  f"decompositions x {fl['decomposition_us']:.2f} us (compiled); the coupled sweep takes "
+                  f"{coupled['floor_ratio']:.2f}x that")
         workers, at_scale, parallel, e2e = {}, {}, None, {}
         if not args.no_workers:
             counts = sorted({int(w) for w in args.workers_list.split(",") if w.strip()})

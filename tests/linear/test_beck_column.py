@@ -263,3 +263,52 @@ def test_kelvin_voigt_damping(n_el, eta):
     res = critical_load(M, K0, K1, D=eta * K0, p_max=P_MAX)
     assert res.kind == "flutter"
     assert res.load == pytest.approx(p_ref, rel=1e-10)
+
+
+# -- large models: modal reduction with error checks, exact onset of the full model -------------
+@pytest.mark.parametrize("n_el", [50, 80])
+def test_large_column_matches_the_fe_models_own_coalescence(n_el):
+    """100 and 160 dofs (above the engine's LARGE_ORDER: reduced, then refined on the full model).
+
+    The dense reference is accurate only to ~eps |M^-1 K| / s_c (stiff element modes): 1e-9 at 50
+    elements, a few 1e-9 at 80; the engine's onset is conditioned at ~2e-10 per ulp of K there."""
+    p_fe, w_fe = fe_coalescence(n_el)
+    M, K0, K1 = beck_matrices(n_el)
+    res = critical_load(M, K0, K1, p_max=P_MAX)
+    assert res.kind == "flutter" and res.warnings == ()
+    assert res.load == pytest.approx(p_fe, rel=1e-9 if n_el == 50 else 1e-8)
+    assert res.omega == pytest.approx(w_fe, rel=1e-7)
+
+
+def test_large_columns_converge_to_the_continuum_like_h4():
+    """40, 80 and 160 elements (80, 160 and 320 dofs; the last two reduced and refined on the
+    full model). The errors against the exact continuum value fall by 2^4 from 40 to 80, and
+    their Richardson extrapolation reproduces it to 1e-9. The 160-element model's onset is
+    itself determined only to ~1e-9 (2e-8 absolute) by its rounded stiffness entries (a random
+    ulp in each moves it by that much), the size of its remaining discretization error: it lies
+    within that of the h^4 prediction from 80 elements."""
+    p_ref, w_ref = continuum_reference()
+    r40, r80, r160 = engine(40), engine(80), engine(160)
+    assert r40.warnings == () and r80.warnings == () and r160.warnings == ()
+    err40, err80 = r40.load - p_ref, r80.load - p_ref
+    assert 0 < err80 < err40 and err40 / err80 == pytest.approx(16.0, rel=0.02)
+    assert (16 * r80.load - r40.load) / 15 == pytest.approx(p_ref, rel=1e-9)
+    assert (16 * r80.omega - r40.omega) / 15 == pytest.approx(w_ref, rel=1e-8)
+    assert abs(r160.load - (p_ref + err80 / 16)) <= 3e-8
+    assert r160.omega == pytest.approx(w_ref, rel=1e-8)
+
+
+def test_a_reduction_that_misses_an_earlier_instability_is_not_used():
+    """100 dofs, M = I, K0 = diag(s_i): the pairs (s_0, s_1) and (s_60, s_61) each coalesce under a
+    circulatory coupling [[0, p], [-p, 0]] at p = (s_j+1 - s_j) / 2: 0.5 for the low pair, 0.25
+    for the high one, which the modal bases of 12 and 24 modes do not contain. The full model's
+    check below the reduced onset finds it unstable, and the problem is solved dense."""
+    n = 100
+    s = np.linspace(1.0, 100.0, n)
+    s[61] = s[60] + 0.5
+    K1 = np.zeros((n, n))
+    K1[0, 1], K1[1, 0] = 1.0, -1.0
+    K1[60, 61], K1[61, 60] = 1.0, -1.0
+    res = critical_load(np.eye(n), np.diag(s), K1, p_max=2.0)
+    assert res.load == pytest.approx(0.25, rel=1e-12) and res.kind == "flutter"
+    assert len(res.warnings) == 1 and "solved dense" in res.warnings[0]

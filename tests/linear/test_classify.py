@@ -32,7 +32,10 @@ def _reference(vals, undamped):
         ind = np.stack([np.where(c, worst, gap), np.where(c, worst, srt[:, 0])], axis=-1)
     else:
         growth = (vals.real / mag).max(axis=-1)
-        ind = np.stack([-growth, -growth], axis=-1)
+        freq = np.sort(np.abs(vals.imag) / mag.max(axis=-1, keepdims=True), axis=-1)
+        diffs = np.diff(freq, axis=-1)
+        diffs[diffs < TOL_DUPLICATE] = np.inf
+        ind = np.stack([-growth, np.where(unstable, -growth, diffs.min(axis=-1))], axis=-1)
     return cplx, neg, unstable, ind
 
 
@@ -64,6 +67,8 @@ def test_hand_made_damped_spectra():
     cplx, neg = unstable_masks(lam, False, *ARGS)
     assert cplx[1].tolist() == [True, True, False] and neg[2].tolist() == [False, False, True]
     assert ind[0, 0] == pytest.approx(0.1 / abs(-0.1 + 10j))
+    # the closest gap between distinct frequencies |Im lambda| (10 and 0), relative to max |lambda|
+    assert ind[0, 1] == pytest.approx(10 / abs(-0.1 + 10j)) and ind[1, 1] == ind[1, 0]
 
 
 @pytest.mark.parametrize("undamped", [True, False])

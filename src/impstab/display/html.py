@@ -172,7 +172,7 @@ def study_html(s) -> str:
 
 
 def batch_html(b) -> str:
-    from ..linear.batch.jobs import KINDS, STATUSES
+    from ..linear.batch.results import KINDS, STATUSES
 
     kinds = np.asarray(b.kind)
     status = np.asarray(b.status)

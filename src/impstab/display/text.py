@@ -152,7 +152,7 @@ def study_text(s) -> str:
 
 
 def batch_text(b) -> str:
-    from ..linear.batch.jobs import KINDS
+    from ..linear.batch.results import KINDS
 
     kinds = np.asarray(b.kind)
     counts = ", ".join(f"{name} {int(np.count_nonzero(kinds == code))}" for code, name in enumerate(KINDS)

@@ -7,8 +7,9 @@ and the eigen-decomposition of the whole is that of each block: closed forms for
 and two dofs, the compiled small-matrix routines for larger ones (eigenvalues by
 :mod:`impstab.linear.small_eig`, eigenvectors by :mod:`impstab.linear.small_eigvec`); a
 coupled design is one block of six.
-Design studies solve millions of such eigenproblems, so the batched critical-thrust engine uses
-this decomposition wherever a design has it.
+Design studies solve millions of such eigenproblems, so the stability engine
+(:mod:`impstab.linear.engine`) uses this decomposition wherever a problem has it, through the
+per-design routines :func:`block_eigvals_at` and :func:`block_eig_at`.
 
 Which dofs are coupled
 ----------------------
@@ -43,7 +44,8 @@ from numpy.typing import NDArray
 from .small_eig import MAX_ORDER, _balance, _solve_one, eigvals_affine
 from .small_eigvec import _eig_block
 
-__all__ = ["BlockStructure", "TOL_DECOUPLE", "decoupled_blocks", "eigvals_affine_blocks", "eig_affine"]
+__all__ = ["BlockStructure", "TOL_DECOUPLE", "decoupled_blocks", "eigvals_affine_blocks", "eig_affine",
+           "block_eigvals_at", "block_eig_at", "eig_workspace"]
 
 _EPS = float(np.finfo(float).eps)
 #: coupling (relative to the balanced operator's largest entry) below which dofs are decoupled
@@ -77,7 +79,7 @@ class BlockStructure:
         return BlockStructure(self.order[rows], self.starts[rows], self.nblocks[rows], self.largest[rows])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _structure(a0, a1, p_max, tol, order, starts, nblocks, largest):
     count, n = a0.shape[0], a0.shape[1]
     c = np.empty((n, n))
@@ -157,7 +159,7 @@ def decoupled_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], p_max: ND
     return BlockStructure(order, starts, nblocks, largest)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _values2(a, b, c, d):
     """Eigenvalues of ``[[a, b], [c, d]]`` (LAPACK ``dlanv2``'s standardisation, unscaled)."""
     p = 0.5 * (a - d)
@@ -173,7 +175,7 @@ def _values2(a, b, c, d):
     return complex(m, w), complex(m, -w)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _vector2(lam, a, b, c, d, first):
     """Unit eigenvector of ``[[a, b], [c, d]]`` for ``lam``: the larger of the two row solutions."""
     x1, y1 = complex(b, 0.0), lam - a
@@ -192,7 +194,7 @@ def _vector2(lam, a, b, c, d, first):
     return complex(0.0, 0.0), complex(1.0, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _fill_block(a0, a1, s, p, order, lo, m, w):
     """``w[:m, :m]`` = the block of dofs ``order[s, lo:lo + m]`` of ``a0[s] + p a1[s]``."""
     for x in range(m):
@@ -201,30 +203,39 @@ def _fill_block(a0, a1, s, p, order, lo, m, w):
             w[x, y] = a0[s, i, j] + p * a1[s, i, j]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def block_eigvals_at(a0, a1, s, p, order, starts, nblocks, w, v, wr, wi, out):
+    """Eigenvalues of design ``s`` at load ``p``, block by block, into ``out (n,)``; False: failed.
+
+    ``w (n, n)``, ``v, wr, wi (n,)`` are work arrays.
+    """
+    n = a0.shape[1]
+    good = True
+    for b in range(nblocks[s]):
+        lo, hi = starts[s, b], starts[s, b + 1]
+        m = hi - lo
+        _fill_block(a0, a1, s, p, order, lo, m, w)
+        if m == 1:
+            out[lo] = complex(w[0, 0], 0.0)
+        elif m == 2:
+            l1, l2 = _values2(w[0, 0], w[0, 1], w[1, 0], w[1, 1])
+            out[lo] = l1
+            out[lo + 1] = l2
+        else:
+            good = _solve_one(w, m, v, wr, wi, out[lo:hi]) and good
+    for i in range(n):
+        good = good and np.isfinite(out[i].real) and np.isfinite(out[i].imag)
+    return good
+
+
+@njit(cache=True, error_model="numpy")
 def _eigvals_blocks(a0, a1, loads, order, starts, nblocks, out, ok):
-    count, n = a0.shape[0], a0.shape[1]
+    n = a0.shape[1]
     w = np.empty((n, n))
     v, wr, wi = np.empty(n), np.empty(n), np.empty(n)
-    for s in range(count):
+    for s in range(a0.shape[0]):
         for k in range(loads.shape[1]):
-            p = loads[s, k]
-            good = True
-            for b in range(nblocks[s]):
-                lo, hi = starts[s, b], starts[s, b + 1]
-                m = hi - lo
-                _fill_block(a0, a1, s, p, order, lo, m, w)
-                if m == 1:
-                    out[s, k, lo] = complex(w[0, 0], 0.0)
-                elif m == 2:
-                    l1, l2 = _values2(w[0, 0], w[0, 1], w[1, 0], w[1, 1])
-                    out[s, k, lo] = l1
-                    out[s, k, lo + 1] = l2
-                else:
-                    good = _solve_one(w, m, v, wr, wi, out[s, k, lo:hi]) and good
-            for i in range(n):
-                good = good and np.isfinite(out[s, k, i].real) and np.isfinite(out[s, k, i].imag)
-            ok[s, k] = good
+            ok[s, k] = block_eigvals_at(a0, a1, s, loads[s, k], order, starts, nblocks, w, v, wr, wi, out[s, k])
 
 
 def eigvals_affine_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[np.float64],
@@ -246,69 +257,79 @@ def eigvals_affine_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], load
     return out
 
 
-@njit(cache=True)
-def _eig_blocks(a0, a1, loads, order, starts, nblocks, vals, vecs, inv, ok):
-    """Eigen-decomposition of each design, block by block (closed forms up to two dofs)."""
-    count, n = a0.shape[0], a0.shape[1]
-    w = np.empty((n, n))
-    w0 = np.empty((n, n))
-    v, wr, wi = np.empty(n), np.empty(n), np.empty(n)
-    bv = np.empty(n, dtype=np.complex128)
-    bvec = np.empty((n, n), dtype=np.complex128)
-    binv = np.empty((n, n), dtype=np.complex128)
-    lu = np.empty((n, n), dtype=np.complex128)
-    piv = np.empty(n, dtype=np.int64)
-    x = np.empty(n, dtype=np.complex128)
-    lu_real = np.empty((n, n))
-    x_real = np.empty(n)
-    for s in range(count):
-        p = loads[s]
-        good = True
-        for r in range(n):
-            for c in range(n):
-                vecs[s, r, c] = 0.0
-                inv[s, r, c] = 0.0
-        for b in range(nblocks[s]):
-            lo, hi = starts[s, b], starts[s, b + 1]
-            m = hi - lo
-            _fill_block(a0, a1, s, p, order, lo, m, w0)
-            if m == 1:
-                r = order[s, lo]
-                vals[s, lo] = complex(w0[0, 0], 0.0)
-                vecs[s, r, lo] = 1.0
-                inv[s, lo, r] = 1.0
-                continue
-            if m == 2:
-                i, j = order[s, lo], order[s, lo + 1]
-                a, bb, c, d = w0[0, 0], w0[0, 1], w0[1, 0], w0[1, 1]
-                l1, l2 = _values2(a, bb, c, d)
-                v00, v10 = _vector2(l1, a, bb, c, d, True)
-                v01, v11 = _vector2(l2, a, bb, c, d, False)
-                det = v00 * v11 - v01 * v10
-                if det == 0.0 or not (np.isfinite(det.real) and np.isfinite(det.imag)):
-                    good = False
-                    continue
-                vals[s, lo] = l1
-                vals[s, lo + 1] = l2
-                vecs[s, i, lo] = v00
-                vecs[s, j, lo] = v10
-                vecs[s, i, lo + 1] = v01
-                vecs[s, j, lo + 1] = v11
-                inv[s, lo, i] = v11 / det
-                inv[s, lo, j] = -v01 / det
-                inv[s, lo + 1, i] = -v10 / det
-                inv[s, lo + 1, j] = v00 / det
-                continue
-            w[:m, :m] = w0[:m, :m]
-            if not _eig_block(w, w0, m, v, wr, wi, bv, bvec, binv, lu, piv, x, lu_real, x_real):
+@njit(cache=True, error_model="numpy")
+def eig_workspace(n):
+    """Work arrays of :func:`block_eig_at` for operators of order ``n``."""
+    return (np.empty((n, n)), np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n),
+            np.empty(n, dtype=np.complex128), np.empty((n, n), dtype=np.complex128),
+            np.empty((n, n), dtype=np.complex128), np.empty((n, n), dtype=np.complex128),
+            np.empty(n, dtype=np.int64), np.empty(n, dtype=np.complex128), np.empty((n, n)), np.empty(n))
+
+
+@njit(cache=True, error_model="numpy")
+def block_eig_at(a0, a1, s, p, order, starts, nblocks, vals, vecs, inv, ws):
+    """Eigen-decomposition of design ``s`` at load ``p``, block by block; False: failed.
+
+    Closed forms up to two dofs, else compiled QR and inverse iteration
+    (:mod:`impstab.linear.small_eigvec`). ``vals (n,)``, ``vecs (n, n)`` (unit columns) and
+    ``inv (n, n)`` (``vecs^-1``) receive the result; ``ws`` is :func:`eig_workspace`.
+    """
+    w, w0, v, wr, wi, bv, bvec, binv, lu, piv, x, lu_real, x_real = ws
+    n = a0.shape[1]
+    good = True
+    for r in range(n):
+        for c in range(n):
+            vecs[r, c] = 0.0
+            inv[r, c] = 0.0
+    for b in range(nblocks[s]):
+        lo, hi = starts[s, b], starts[s, b + 1]
+        m = hi - lo
+        _fill_block(a0, a1, s, p, order, lo, m, w0)
+        if m == 1:
+            r = order[s, lo]
+            vals[lo] = complex(w0[0, 0], 0.0)
+            vecs[r, lo] = 1.0
+            inv[lo, r] = 1.0
+            continue
+        if m == 2:
+            i, j = order[s, lo], order[s, lo + 1]
+            a, bb, c, d = w0[0, 0], w0[0, 1], w0[1, 0], w0[1, 1]
+            l1, l2 = _values2(a, bb, c, d)
+            v00, v10 = _vector2(l1, a, bb, c, d, True)
+            v01, v11 = _vector2(l2, a, bb, c, d, False)
+            det = v00 * v11 - v01 * v10
+            if det == 0.0 or not (np.isfinite(det.real) and np.isfinite(det.imag)):
                 good = False
                 continue
-            for xx in range(m):
-                vals[s, lo + xx] = bv[xx]
-                for yy in range(m):
-                    vecs[s, order[s, lo + xx], lo + yy] = bvec[xx, yy]
-                    inv[s, lo + xx, order[s, lo + yy]] = binv[xx, yy]
-        ok[s] = good
+            vals[lo] = l1
+            vals[lo + 1] = l2
+            vecs[i, lo] = v00
+            vecs[j, lo] = v10
+            vecs[i, lo + 1] = v01
+            vecs[j, lo + 1] = v11
+            inv[lo, i] = v11 / det
+            inv[lo, j] = -v01 / det
+            inv[lo + 1, i] = -v10 / det
+            inv[lo + 1, j] = v00 / det
+            continue
+        w[:m, :m] = w0[:m, :m]
+        if not _eig_block(w, w0, m, v, wr, wi, bv, bvec, binv, lu, piv, x, lu_real, x_real):
+            good = False
+            continue
+        for xx in range(m):
+            vals[lo + xx] = bv[xx]
+            for yy in range(m):
+                vecs[order[s, lo + xx], lo + yy] = bvec[xx, yy]
+                inv[lo + xx, order[s, lo + yy]] = binv[xx, yy]
+    return good
+
+
+@njit(cache=True, error_model="numpy")
+def _eig_blocks(a0, a1, loads, order, starts, nblocks, vals, vecs, inv, ok):
+    """Eigen-decomposition of each design, block by block (closed forms up to two dofs)."""
+    ws = eig_workspace(a0.shape[1])
+    for s in range(a0.shape[0]):
+        ok[s] = block_eig_at(a0, a1, s, loads[s], order, starts, nblocks, vals[s], vecs[s], inv[s], ws)
 
 
 def _lapack(ops: NDArray[np.float64]) -> tuple:

@@ -11,8 +11,11 @@ of a soft one, with a rounding floor relative to the largest eigenvalue of its p
 
 The scan indicator of a problem (two columns, both negative once unstable): for undamped
 problems the closest approach of two distinct frequencies and the smallest ``s`` (each relative
-to the largest ``|s|``; duplicates closer than ``TOL_DUPLICATE`` are one frequency), for damped
-ones minus the largest relative growth rate.
+to the largest ``|s|``; duplicates closer than ``TOL_DUPLICATE`` are one frequency); for
+first-order ones minus the largest relative growth rate, and the closest approach of two
+distinct frequencies ``|Im lambda|`` (relative to the largest ``|lambda|``), which is what can
+announce a flutter bubble where every growth rate is zero to rounding (an undamped system
+written in first-order form).
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from numpy.typing import NDArray
 __all__ = ["unstable_masks", "classify_eigenvalues"]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _masks(vals, undamped, tol_unstable, tol_cluster, floor_rel, cplx, neg):
     count, n = vals.shape
     for s in range(count):
@@ -46,7 +49,7 @@ def _masks(vals, undamped, tol_unstable, tol_cluster, floor_rel, cplx, neg):
                 neg[s, i] = grow and real
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _indicators(vals, undamped, cplx, neg, tol_duplicate, unstable, indicator):
     count, n = vals.shape
     re = np.empty(n)
@@ -80,10 +83,24 @@ def _indicators(vals, undamped, cplx, neg, tol_duplicate, unstable, indicator):
             indicator[s, 1] = -worst if any_c else re[0]
         else:
             growth = -np.inf
+            scale = 0.0
             for i in range(n):
                 growth = max(growth, vals[s, i].real / max(abs(vals[s, i]), 1e-300))
+                scale = max(scale, abs(vals[s, i]), 1e-300)
+            for i in range(n):  # insertion sort of the scaled frequencies
+                x = abs(vals[s, i].imag) / scale
+                j = i
+                while j > 0 and re[j - 1] > x:
+                    re[j] = re[j - 1]
+                    j -= 1
+                re[j] = x
+            gap = np.inf
+            for i in range(n - 1):
+                d = re[i + 1] - re[i]
+                if d >= tol_duplicate and d < gap:
+                    gap = d
             indicator[s, 0] = -growth
-            indicator[s, 1] = -growth
+            indicator[s, 1] = -growth if bad else gap
 
 
 def unstable_masks(vals: NDArray[np.complex128], undamped: bool, tol_unstable: float, tol_cluster: float,

@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from .participation import participation_into
+
 __all__ = ["state_matrices", "stiffness_eigenvalues", "state_eigenvalues", "kinetic_shares", "cluster_participation"]
 
 Array = NDArray[np.float64]
@@ -83,24 +85,16 @@ def cluster_participation(shapes: NDArray, values: NDArray, members: NDArray, m_
         Sums to 1 over the dofs.
     """
     shapes = np.asarray(shapes, dtype=complex)
+    values = np.asarray(values, dtype=complex)
     members = np.asarray(members, dtype=bool)
-    y = shapes * np.sqrt(np.asarray(m_diag, dtype=float))[..., :, None] * members[..., None, :]
-    scale = np.abs(np.where(members, values, 0)).max(axis=-1)[..., None, None]
-    same = (np.abs(values[..., :, None] - values[..., None, :]) <= tol * scale) & members[..., :, None] & members[..., None, :]
-    eye = np.eye(members.shape[-1], dtype=bool)
-    gram = np.where(same, np.conj(np.swapaxes(y, -1, -2)) @ y, 0) + (eye & ~members[..., :, None])
-    # diag(Y G^-1 Y^H) with the Gram matrix G taken within each repeated eigenvalue only: the sum
-    # of the projectors onto each eigenspace (for a simple eigenvalue |y|^2 / y^H y)
-    try:
-        sol = np.linalg.solve(gram, np.conj(np.swapaxes(y, -1, -2)))
-        share = (y * np.swapaxes(sol, -1, -2)).sum(axis=-1).real
-        good = np.isfinite(share).all(axis=-1) & (share.min(axis=-1, initial=0.0) > -1e-12)
-    except np.linalg.LinAlgError:  # a defective repeated eigenvalue somewhere: mode by mode
-        share, good = np.zeros(y.shape[:-1]), np.zeros(y.shape[:-2], dtype=bool)
-    if not np.all(good):
-        w = np.abs(y) ** 2
-        total = w.sum(axis=-2, keepdims=True)
-        each = (w / np.where(total > 0, total, 1.0)).sum(axis=-1)
-        share = np.where(good[..., None], share, each)
-    share = np.maximum(share, 0.0)
-    return share / np.maximum(members.sum(axis=-1), 1)[..., None]
+    m_diag = np.asarray(m_diag, dtype=float)
+    n, k = shapes.shape[-2:]
+    lead = np.broadcast_shapes(shapes.shape[:-2], values.shape[:-1], members.shape[:-1], m_diag.shape[:-1])
+    flat_s = np.ascontiguousarray(np.broadcast_to(shapes, lead + (n, k)).reshape(-1, n, k))
+    flat_v = np.ascontiguousarray(np.broadcast_to(values, lead + (k,)).reshape(-1, k))
+    flat_m = np.ascontiguousarray(np.broadcast_to(members, lead + (k,)).reshape(-1, k))
+    flat_w = np.ascontiguousarray(np.broadcast_to(m_diag, lead + (n,)).reshape(-1, n))
+    out = np.empty((len(flat_s), n))
+    for r in range(len(flat_s)):
+        participation_into(flat_s[r], flat_v[r], flat_m[r], flat_w[r], float(tol), out[r])
+    return out.reshape(lead + (n,))

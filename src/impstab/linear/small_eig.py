@@ -2,8 +2,8 @@
 
 LAPACK's ``geev`` spends most of its time on a 6 x 6 or 12 x 12 matrix in call overhead and
 blocking logic meant for large ones (about 2.6 us for a 6 x 6 scan operator, against 0.9 us
-here). The thrust scans of the critical-load engine classify thousands of such matrices, so
-they use this routine; eigenvectors and everything outside the scans stay with LAPACK.
+here). The stability engine classifies thousands of such matrices, so it uses this routine
+(eigenvectors come from :mod:`impstab.linear.small_eigvec`, built on it).
 
 Algorithm (the classical eigenvalue-only path of EISPACK / LAPACK ``dlahqr``):
 
@@ -36,7 +36,7 @@ _EPS = float(np.finfo(float).eps)
 _MAX_ITERATIONS = 60  # per eigenvalue, as EISPACK hqr (30 per eigenvalue in dlahqr, x n in total)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _balance(a, n, f):
     """Scale rows and columns by powers of two until their off-diagonal norms are comparable.
 
@@ -76,7 +76,7 @@ def _balance(a, n, f):
                     a[j, i] *= step
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _hessenberg(a, n, v):
     """Householder reduction of ``a`` (in place) to upper Hessenberg form."""
     for k in range(n - 2):
@@ -115,7 +115,7 @@ def _hessenberg(a, n, v):
             a[i, k] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _hessenberg_norm(a, n):
     s = 0.0
     for i in range(n):
@@ -124,7 +124,7 @@ def _hessenberg_norm(a, n):
     return s
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _francis(a, n, wr, wi):  # noqa: C901 - one algorithm, kept in one piece
     """Eigenvalues of the upper Hessenberg ``a`` (destroyed) into ``wr + i wi``; False: no convergence."""
     hi = n - 1
@@ -247,7 +247,7 @@ def _francis(a, n, wr, wi):  # noqa: C901 - one algorithm, kept in one piece
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _solve_one(a, n, v, wr, wi, out_row):
     """Eigenvalues of the matrix in ``a`` (destroyed) into ``out_row``.
 
@@ -265,7 +265,7 @@ def _solve_one(a, n, v, wr, wi, out_row):
     return ok
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _eigvals_stack(ops, out, ok):
     n = ops.shape[1]
     a, v, wr, wi = np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n)
@@ -274,7 +274,7 @@ def _eigvals_stack(ops, out, ok):
         ok[s] = _solve_one(a, n, v, wr, wi, out[s])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _eigvals_affine(a0, a1, loads, out, ok):
     n = a0.shape[1]
     a, v, wr, wi = np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n)

@@ -1,4 +1,4 @@
-"""The linearized system ``M q'' + (D + G) q' + K q = 0`` at one thrust."""
+"""The linearized system ``M q'' + (D + G) q' + K q = 0`` at one thrust, and its first-order form."""
 
 from __future__ import annotations
 
@@ -51,6 +51,25 @@ class LinearSystem:
     def state_matrix(self) -> Array:
         """``A = [[0, I], [-M^-1 K, -M^-1 (D + G)]]`` for ``x = (q, q')``."""
         return state_matrices(self.M, self.D + self.G, self.K)
+
+    def first_order(self) -> tuple[Array, Array]:
+        """The first-order form ``E x' = A x`` for ``x = (q, q')``, without inverting M.
+
+        Returns
+        -------
+        E : (12, 12) array
+            ``[[I, 0], [0, M]]``.
+        A : (12, 12) array
+            ``[[0, I], [-K, -(D + G)]]``; ``E^-1 A`` is :meth:`state_matrix`.
+        """
+        n = self.M.shape[0]
+        e = np.eye(2 * n)
+        e[n:, n:] = self.M
+        a = np.zeros((2 * n, 2 * n))
+        a[:n, n:] = np.eye(n)
+        a[n:, :n] = -self.K
+        a[n:, n:] = -(self.D + self.G)
+        return e, a
 
     @property
     def stiffness_symmetric(self) -> Array:

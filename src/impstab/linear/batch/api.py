@@ -1,4 +1,4 @@
-"""Entry point: critical thrust of many models at once."""
+"""Entry point: critical thrust of many models at once, in one call of the stability engine."""
 
 from __future__ import annotations
 
@@ -7,15 +7,14 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ...model.model import Model
-from ..critical_thrust import _modes
+from ...model.model import DOF_NAMES, Model
+from ..critical_thrust import PARTICIPATION_THRESHOLD, _modes
+from ..engine import Problem, StackOutcome, second_order_problem, solve, solve_affine
+from ..engine.problems import mass_solve
 from ..linearize import ModelFamily
-from .jobs import KINDS, STATUSES, AffineDesign, BatchCriticalThrust, _Job
-from .refine import _solve_jobs
-from .scan import _operators, _prime
+from .results import KINDS, STATUSES, AffineDesign, BatchCriticalThrust
 
 Array = NDArray[np.float64]
-
 
 
 def _single(model: Model) -> tuple:
@@ -24,6 +23,33 @@ def _single(model: Model) -> tuple:
 
     r = critical_thrust(model)
     return (r.thrust, r.kind, r.omega, r.participation, r.warnings), (r.undamped_thrust, r.undamped_kind)
+
+
+def _affine_stack(designs: list[AffineDesign], n_scan: int, vectorized: bool):
+    """The undamped problems ``M^-1 K0 + T M^-1 K1`` of designs given by their matrices, solved at once."""
+    m = np.stack([d.mass for d in designs])
+    a0, a1 = np.moveaxis(mass_solve(m, np.stack([[d.k0, d.k1] for d in designs])), 1, 0)
+    weights = np.diagonal(m, axis1=1, axis2=2)
+    t_max = np.array([d.thrust_max for d in designs], dtype=float)
+    if vectorized:
+        return solve_affine(a0, a1, weights, t_max, n_scan=n_scan)
+    parts = [solve_affine(a0[i:i + 1], a1[i:i + 1], weights[i:i + 1], t_max[i:i + 1], n_scan=n_scan)
+             for i in range(len(designs))]
+    return _joined(parts)
+
+
+def _joined(parts: list[StackOutcome]) -> StackOutcome:
+    """Stack outcomes of consecutive parts as one."""
+    arrays = {f: np.concatenate([getattr(r, f) for r in parts])
+              for f in ("load", "kind", "omega", "participation", "evaluations", "decompositions", "pairs")}
+    return StackOutcome(warnings=[w for r in parts for w in r.warnings], **arrays)
+
+
+def _mode_names(participation: Array) -> list[str]:
+    """The dofs with at least 5 % of the kinetic energy, comma-separated, for each row."""
+    bits = (participation >= PARTICIPATION_THRESHOLD) @ (1 << np.arange(participation.shape[-1]))
+    names = {b: ",".join(n for i, n in enumerate(DOF_NAMES) if b >> i & 1) for b in np.unique(bits).tolist()}
+    return [names[b] for b in bits.tolist()]
 
 
 def critical_thrust_batch(
@@ -37,12 +63,13 @@ def critical_thrust_batch(
         The designs; None marks a design to skip (status ``"invalid"``, empty message, for the
         caller to fill in). An :class:`AffineDesign` (matrices of an undamped affine design,
         assembled in bulk by a design study) is searched exactly as its model would be.
-    n_scan, chunk : int
-        Scan intervals, and scan points classified per batch (a design whose scan has gone
-        unstable takes no further chunks).
+    n_scan : int
+        Scan intervals.
+    chunk : int
+        Scan points per evaluation of a design whose linearization is not affine in the thrust.
     vectorized : bool
-        Vectorize the engine's steps across affine undamped designs (default); False runs every
-        design's own engine after the batched scan.
+        Solve all designs in one call of the engine (default), or each in a call of its own (the
+        same engine, a stack of one: for checks).
 
     Returns
     -------
@@ -56,17 +83,38 @@ def critical_thrust_batch(
     kind, ukind = np.full(n, -1, dtype=np.int8), np.full(n, -1, dtype=np.int8)
     status = np.full(n, STATUSES.index("invalid"), dtype=np.int8)
     message, modes = [""] * n, [""] * n
-    jobs: list[_Job] = []
-    owner: dict[int, tuple[int, bool]] = {}
+    problems: list[Problem] = []
+    owner: list[tuple[int, bool]] = []
     done: dict[int, tuple] = {}
+    affine_evaluations = decompositions = pairs = 0
+    affine = [i for i, m in enumerate(models) if isinstance(m, AffineDesign)]
+    if affine:
+        for i in affine:
+            out["t_max"][i], out["operating"][i] = models[i].thrust_max, models[i].operating
+        rows, stack = affine, None
+        try:
+            stack = _affine_stack([models[i] for i in affine], n_scan, vectorized)
+        except np.linalg.LinAlgError:  # a singular mass somewhere: design by design
+            rows, parts = [], []
+            for i in affine:
+                try:
+                    parts.append(_affine_stack([models[i]], n_scan, True))
+                    rows.append(i)
+                except Exception as exc:  # noqa: BLE001 - reported per design
+                    status[i], message[i] = _failure(exc)
+            if parts:
+                stack = _joined(parts)
+        if stack is not None:
+            idx = np.array(rows)
+            out["thrust"][idx], out["omega"][idx], kind[idx] = stack.load, stack.omega, stack.kind
+            out["undamped"][idx], ukind[idx] = stack.load, stack.kind
+            status[idx] = 0
+            for i, names, warn in zip(rows, _mode_names(stack.participation), stack.warnings):
+                modes[i], message[i] = names, "; ".join(warn)
+            affine_evaluations = int(stack.evaluations.sum())
+            decompositions, pairs = int(stack.decompositions.sum()), int(stack.pairs.sum())
     for i, model in enumerate(models):
-        if model is None:
-            continue
-        if isinstance(model, AffineDesign):
-            out["t_max"][i], out["operating"][i] = model.thrust_max, model.operating
-            job = _Job.affine(model, n_scan)
-            jobs.append(job)
-            owner[id(job)] = (i, True)
+        if model is None or isinstance(model, AffineDesign):
             continue
         out["t_max"][i] = t_max = float(model.analysis.thrust_max)
         out["operating"][i] = np.nan if model.thrust.operating is None else float(model.thrust.operating)
@@ -74,33 +122,34 @@ def critical_thrust_batch(
             if model.fluid.compressible:
                 done[i] = _single(model)
                 continue
-            built = [(_Job(ModelFamily(model, None, damped=True), t_max, n_scan), True)]
+            built = [(second_order_problem(ModelFamily(model, None, damped=True), t_max, n_scan=n_scan), True)]
             if model.is_damped:
-                built.append((_Job(ModelFamily(model, None, damped=False), t_max, n_scan), False))
+                built.append((second_order_problem(ModelFamily(model, None, damped=False), t_max, n_scan=n_scan), False))
         except Exception as exc:  # noqa: BLE001 - reported per design
             status[i], message[i] = _failure(exc)
             continue
-        for job, damped in built:
-            jobs.append(job)
-            owner[id(job)] = (i, damped)
-    errors: dict[int, Exception] = {}
-    _operators(jobs)
-    _prime(jobs, chunk, errors)
-    results = _solve_jobs(jobs, chunk, vectorized, errors)
-    pairs: dict[int, dict[bool, _Job]] = {}
-    for job in jobs:
-        i, damped = owner[id(job)]
-        pairs.setdefault(i, {})[damped] = job
+        for problem, damped in built:
+            problems.append(problem)
+            owner.append((i, damped))
+    if vectorized:
+        outcomes = solve(problems, chunk=chunk) if problems else []
+    else:
+        outcomes = [solve([p], chunk=chunk)[0] for p in problems]
+    pairs: dict[int, dict[bool, object]] = {}
+    for (i, damped), res in zip(owner, outcomes):
+        pairs.setdefault(i, {})[damped] = res
     for i, pair in pairs.items():
-        err = next((errors[id(j)] for j in pair.values() if id(j) in errors), None)
+        err = next((r.error for r in pair.values() if r.error is not None), None)
         if err is not None:
             status[i], message[i] = _failure(err)
             continue
-        res, und = results[id(pair[True])], None
+        r = pair[True]
+        res = (r.load, r.kind, r.omega, r.participation, r.warnings)
+        und = None
         if False in pair:
-            u = results[id(pair[False])]
-            und = u[:2]
-            res = (*res[:4], res[4] + tuple(f"undamped companion: {w}" for w in u[4]))
+            u = pair[False]
+            und = (u.load, u.kind)
+            res = (*res[:4], res[4] + tuple(f"undamped companion: {w}" for w in u.warnings))
         done[i] = (res, und)
     for i, (res, und) in done.items():
         p, k, omega, part, warn = res
@@ -110,14 +159,14 @@ def critical_thrust_batch(
         kind[i], modes[i] = KINDS.index(k), ",".join(_modes(part))
         up, uk = (p, k) if und is None else und
         out["undamped"][i], ukind[i] = (np.nan if up is None else up), KINDS.index(uk)
-    evaluations = sum(j.evaluations + (j._engine.evaluations if j._engine is not None else 0) for j in jobs)
+    evaluations = sum(r.evaluations for r in outcomes) + affine_evaluations
     return BatchCriticalThrust(
         out["thrust"], kind, out["omega"], out["undamped"], ukind, out["t_max"], out["operating"],
-        modes, status, message, evaluations,
+        modes, status, message, evaluations, decompositions, pairs,
     )
 
 
-def _failure(exc: Exception) -> tuple[int, str]:
+def _failure(exc: BaseException) -> tuple[int, str]:
     """Status code and one-line message of a design whose analysis raised."""
     from ...errors import ModelError, NumericalError
 

@@ -1,0 +1,223 @@
+"""Large undamped second-order problems: modal reduction with error checks, then the exact onset of
+the full model by shift-invert (a finite-element model with hundreds of dofs).
+
+For ``M q'' + (K0 + p K1) q = 0`` with symmetric ``M`` (positive definite) and ``K0`` of order
+``n`` above :data:`LARGE_ORDER`:
+
+1. *Modal basis.* The ``m`` lowest modes of ``K0 phi = omega^2 M phi`` by shift-invert Lanczos
+   (``scipy.sparse.linalg.eigsh`` about 0), mass-normalised: accurate to rounding relative to each
+   eigenvalue even when the stiff element modes make ``|M^-1 K|`` ten orders above them (a dense
+   solver gets the lowest ones only to ``eps`` of the largest).
+2. *Reduced problems.* ``Omega^2 + p Phi^T K1 Phi`` with ``m`` and ``2 m`` modes, solved by the
+   engine (scan with the bubble searches, exact refinement). Error check: both find the same kind
+   of first loss and their loads agree to :data:`TRUNCATION_TOLERANCE`; otherwise the basis is
+   doubled (up to ``n / 2``; beyond that the problem is solved dense).
+3. *The full model's onset.* The merging cluster of the full pencil ``(K(p), M)`` near the reduced
+   onset is followed by shift-invert subspace iteration (right and left, ``k`` vectors, a sparse
+   or dense LU of ``K(p) - sigma M``, ``sigma`` the cluster mean) until its projected matrix
+   ``C = (Y^T M X)^-1 Y^T K X`` is converged to rounding. The engine's exact indicator
+   ``Delta = k tr C^2 - (tr C)^2`` (divergence: ``tr C / k``) and its derivative
+   ``Delta' = 2 k tr(C B) - 2 tr C tr B``, ``B = (Y^T M X)^-1 Y^T K1 X``, drive the same bracketed
+   Newton iteration as the engine's refinement.
+4. *Error check on the full model.* Every eigenvalue of the full ``M^-1 K`` just below the onset
+   (``p_c (1 - 1e-6)``, one dense eigenvalue problem) must be stable by the engine's rule, and the
+   cluster just above it complex (flutter) or through zero (divergence). If any check fails the
+   problem goes to the dense route, with a warning saying why.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sparse
+import scipy.sparse.linalg as spla
+from numpy.typing import NDArray
+
+from ..classify import classify_eigenvalues
+from ..eigen import cluster_participation
+from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_UNSTABLE
+
+__all__ = ["LARGE_ORDER", "BASIS", "TRUNCATION_TOLERANCE", "reducible", "modal_basis", "reduced_problem", "full_onset",
+           "stable_at"]
+
+Array = NDArray[np.float64]
+
+#: operators of undamped second-order problems above this order are reduced
+LARGE_ORDER = 96
+#: modes in the first reduced basis (it and its double are solved by the compiled routines)
+BASIS = 12
+#: relative agreement of the onsets with m and 2 m modes that accepts the truncation
+TRUNCATION_TOLERANCE = 1e-4
+
+
+def reducible(problem) -> bool:
+    """An affine undamped second-order problem of large order with symmetric M and K0."""
+    if not (problem.undamped and problem.affine and problem.second_order is not None and problem.order > LARGE_ORDER):
+        return False
+    m, k0 = problem.second_order[0], problem.second_order[1]
+    scale_m, scale_k = np.abs(m).max(), np.abs(k0).max()
+    return bool(np.abs(m - m.T).max() <= 1e-13 * scale_m and np.abs(k0 - k0.T).max() <= 1e-13 * scale_k)
+
+
+def _sparse_or_dense(a: Array):
+    return sparse.csc_matrix(a) if np.count_nonzero(a) < 0.1 * a.size else a
+
+
+def modal_basis(problem, m: int) -> tuple[Array, Array]:
+    """The ``m`` lowest mass-normalised modes ``(omega^2, Phi)`` of ``K0 phi = omega^2 M phi``."""
+    mass, k0, _ = problem.second_order
+    n = mass.shape[0]
+    if m >= n - 1:
+        w, phi = sla.eigh(k0, mass)
+    else:
+        start = mass @ np.linspace(1.0, 2.0, n)  # a fixed start: the same basis on every run
+        w, phi = spla.eigsh(_sparse_or_dense(k0), k=m, M=_sparse_or_dense(mass), sigma=0.0, which="LM", v0=start)
+    order = np.argsort(w)
+    w, phi = w[order], phi[:, order]
+    phi = phi / np.sqrt(np.einsum("ij,ik,kj->j", phi, mass, phi))
+    return w, phi
+
+
+def reduced_problem(problem, w: Array, phi: Array):
+    """The undamped problem ``Omega^2 + p Phi^T K1 Phi`` of the modal basis (``M_r = I``)."""
+    from .problems import Problem
+
+    _, _, k1 = problem.second_order
+    a1 = np.ascontiguousarray(phi.T @ k1 @ phi)
+    m = len(w)
+    return Problem(True, problem.p_min, problem.p_max, problem.n_scan, m, m, np.diag(w).copy(), a1, np.ones(m))
+
+
+class _Pencil:
+    """The full pencil ``(K0 + p K1, M)`` and its cluster by shift-invert subspace iteration."""
+
+    def __init__(self, problem) -> None:
+        self.mass, self.k0, self.k1 = problem.second_order
+        self.sparse = np.count_nonzero(self.k0) < 0.1 * self.k0.size
+
+    def _factor(self, p: float, sigma: float):
+        a = self.k0 + p * self.k1 - sigma * self.mass
+        if self.sparse:
+            lu = spla.splu(sparse.csc_matrix(a))
+            return lambda b, trans="N": lu.solve(b, trans=trans)
+        lu = sla.lu_factor(a)
+        return lambda b, trans="N": sla.lu_solve(lu, b, trans=0 if trans == "N" else 1)
+
+    def cluster(self, p: float, sigma: float, x: Array, y: Array, iterations: int = 30):
+        """Right and left bases of the cluster near ``sigma`` at ``p``, and ``C``, ``B``.
+
+        Subspace iteration with ``S = (K(p) - sigma M)^-1 M`` and its transpose. The cluster's
+        matrix comes from the Ritz matrix of ``S`` itself, ``T = (Y^T M X)^-1 Y^T M S X``, as
+        ``C = sigma I + T^-1``: no product with the stiff ``K`` (whose rounding, ``eps |K|``, is ten
+        orders above the low eigenvalues of a fine mesh), only solves with its LU, which are backward
+        stable. The iteration stops when ``tr C`` and ``tr C^2`` change by less than 64 eps, or stop
+        changing less (the rounding floor; each step multiplies the error by the ratio of the
+        cluster's distance to ``sigma`` to that of the next eigenvalue, tiny near a coalescence).
+        """
+        solve = self._factor(p, sigma)
+        eye = np.eye(x.shape[1])
+        prev, change = None, np.inf
+        for _ in range(iterations):
+            z = solve(self.mass @ x)
+            g = y.T @ self.mass @ x
+            t = np.linalg.solve(g, y.T @ self.mass @ z)
+            c = sigma * eye + np.linalg.inv(t)
+            b = np.linalg.solve(g, y.T @ self.k1 @ x)
+            sums = np.array([np.trace(c), np.trace(c @ c)])
+            x, _ = np.linalg.qr(z)
+            y, _ = np.linalg.qr(solve(self.mass.T @ y, trans="T"))
+            if prev is not None:
+                new_change = float(np.max(np.abs(sums - prev) / np.maximum(np.abs(sums), 1e-300)))
+                if new_change <= 64 * np.finfo(float).eps or new_change >= change:
+                    break
+                change = new_change
+            prev = sums
+        return x, y, c, b
+
+    def stable_everywhere(self, p: float) -> bool:
+        """Whether every eigenvalue of the full ``M^-1 K(p)`` is stable by the engine's rule."""
+        s = sla.eigvals(self.k0 + p * self.k1, self.mass)
+        unstable, _ = classify_eigenvalues(s[None], True, TOL_UNSTABLE, TOL_CLUSTER, FLOOR, TOL_DUPLICATE)
+        return not bool(unstable[0])
+
+
+def stable_at(problem, p: float) -> bool:
+    """Whether the full model is stable at ``p`` (every eigenvalue, dense)."""
+    return _Pencil(problem).stable_everywhere(p)
+
+
+def _indicator(c: Array, b: Array, divergence: bool) -> tuple[float, float]:
+    k = c.shape[0]
+    if divergence:
+        return float(np.trace(c).real / k), float(np.trace(b).real / k)
+    tc, tb = np.trace(c), np.trace(b)
+    return float((k * np.trace(c @ c) - tc * tc).real), float((2 * k * np.trace(c @ b) - 2 * tc * tb).real)
+
+
+def full_onset(problem, reduced_load: float, kind: str, omega: float, w: Array, phi: Array, width: float):
+    """The full model's onset near the reduced one (see the module notes), or ``(None, reason)``.
+
+    Returns ``((load, kind, omega, mode, participation), "")`` on success.
+    """
+    from .refine import newton_step
+
+    pencil = _Pencil(problem)
+    divergence = kind == "divergence"
+    # the reduced cluster at its onset, lifted to the full model
+    a_r = np.diag(w) + reduced_load * (phi.T @ pencil.k1 @ phi)
+    s, v = np.linalg.eig(a_r)
+    # the cluster: the eigenvalues at the onset value s_c = omega^2 (divergence: 0), relative to
+    # the spectral radius of the reduced operator
+    s_c = 0.0 if divergence else omega * omega
+    sel = np.flatnonzero(np.abs(s - s_c) <= 1e-4 * max(abs(s_c), 1e-6 * np.abs(s).max()))
+    if sel.size < (1 if divergence else 2):
+        return None, "the reduced onset's cluster could not be identified"
+    lifted = phi @ v[:, sel]  # a real basis of the cluster's (real) invariant subspace
+    x = np.linalg.svd(np.concatenate([lifted.real, lifted.imag], axis=1), full_matrices=False)[0][:, : sel.size]
+    y = pencil.mass @ x
+    sigma = float(np.mean(s[sel].real)) if not divergence else 0.0
+
+    def value(p: float, sigma: float, x: Array, y: Array):
+        x, y, c, b = pencil.cluster(p, sigma, x, y)
+        f, df = _indicator(c, b, divergence)
+        return f, df, x, y, c
+
+    lo, hi = reduced_load * (1 - width), reduced_load * (1 + width)
+    for _ in range(6):  # widen until the indicator changes sign over the bracket
+        f_lo, _, x_lo, y_lo, _ = value(lo, sigma, x, y)
+        f_hi, _, x_hi, y_hi, _ = value(hi, sigma, x, y)
+        if np.sign(f_lo) != np.sign(f_hi):
+            break
+        lo, hi = reduced_load - 4 * (reduced_load - lo), reduced_load + 4 * (hi - reduced_load)
+    else:
+        return None, "the exact indicator of the full model did not change sign near the reduced onset"
+    st = np.array([lo, hi, f_lo, np.nan])
+    p = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+    root = None
+    for _ in range(60):
+        f, df, x, y, c = value(p, sigma, x, y)
+        if not divergence:
+            sigma = float(np.trace(c).real / c.shape[0])
+        new, done = newton_step(st, p, f, df)
+        if done:
+            root = new
+            break
+        p = new
+    if root is None:
+        return None, "the Newton iteration on the full model did not converge"
+    below = root - 1e-6 * abs(root) * np.sign(hi - lo)
+    if not pencil.stable_everywhere(below):
+        return None, f"the full model is already unstable at {below:.10g}, below the reduced onset"
+    x, y, c, _ = pencil.cluster(root, sigma, x, y)
+    vals, vecs = np.linalg.eig(c)
+    shapes = x @ vecs
+    if divergence:
+        omega = 0.0
+    else:
+        omega = float(np.sqrt(max(np.trace(c).real / c.shape[0], 0.0)))
+    lead = int(np.argmax(np.abs(vals.imag))) if not divergence else 0
+    mode = shapes[:, lead]
+    big = int(np.argmax(np.abs(mode)))
+    mode = mode * np.conj(mode[big]) / abs(mode[big]) ** 2
+    part = cluster_participation(shapes, vals, np.ones(len(vals), dtype=bool), np.diag(pencil.mass), TOL_DUPLICATE)
+    return (float(root), kind, omega, mode, part), ""

@@ -1,0 +1,244 @@
+"""Problems of the engine: one-parameter operator families, built from second- and first-order systems.
+
+A :class:`Problem` is what the engine solves: the operator ``A(p)`` whose spectrum decides
+stability on ``[p_min, p_max]``, given as ``A0 + p A1`` (affine) or by a provider (any other
+family), and what the onset values need (the dofs of the mode, the participation weights).
+
+* a second-order family ``M q'' + (D + G) q' + K(p) q = 0`` without damping and gyroscopic terms
+  is an *undamped* problem: ``A = M^-1 K`` with eigenvalues ``s = omega^2`` (stable: all real and
+  positive), ``n`` states;
+* with damping or gyroscopic terms it is a first-order problem on ``x = (q, q')``:
+  ``A = [[0, I], [-M^-1 K, -M^-1 (D + G)]]``, ``2 n`` states, eigenvalues ``lambda`` (stable: all
+  ``Re lambda < 0``); the mode and the participation are those of ``q``;
+* a first-order family ``E x' = A(p) x`` is a first-order problem with ``A = E^-1 A(p)``; its
+  first ``n_dof`` states are the ones the mode and participation are reported for.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from numba import njit
+
+from ..eigen import state_matrices
+from ..small_eigvec import _lu, _lu_solve
+from .large import LARGE_ORDER
+
+__all__ = ["Problem", "second_order_problem", "first_order_problem", "mass_solve"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(eq=False)
+class Problem:
+    """One critical-load search.
+
+    Attributes
+    ----------
+    undamped : bool
+        Eigenvalues are ``s = omega^2`` of ``M^-1 K`` (True) or ``lambda`` of a first-order
+        operator (False).
+    p_min, p_max : float
+        Load range.
+    n_scan : int
+        Scan intervals on it.
+    order : int
+        Order ``N`` of the operator.
+    n_dof : int
+        Leading states in the reported mode and participation.
+    a0, a1 : (N, N) arrays or None
+        ``A = a0 + p a1`` for affine problems.
+    weights : (n_dof,) array
+        Participation weights (mass diagonal), for affine problems.
+    second_order : tuple of arrays or None
+        ``(M, K0, K1)`` of an affine undamped second-order problem (for the reduction of large
+        ones, :mod:`impstab.linear.engine.large`).
+    provider : object or None
+        For the others: ``operators(loads) -> (m, N, N)`` (NaN where no operator exists),
+        ``weights(p) -> (n_dof,)``, and ``fold_indicator(p) -> float`` (the square of the
+        smallest eigenvalue magnitude of the static problem, for limit points).
+    """
+
+    undamped: bool
+    p_min: float
+    p_max: float
+    n_scan: int
+    order: int
+    n_dof: int
+    a0: Array | None = None
+    a1: Array | None = None
+    weights: Array | None = None
+    provider: object | None = None
+    second_order: tuple | None = None
+
+    @property
+    def affine(self) -> bool:
+        return self.a0 is not None or self.second_order is not None
+
+    def operators(self) -> tuple[Array, Array]:
+        """``(a0, a1)`` of an affine problem (formed from ``second_order`` when first needed)."""
+        if self.a0 is None:
+            m, k0, k1 = self.second_order
+            self.a0, self.a1 = mass_solve(m[None], np.array([[k0, k1]]))[0]
+        return self.a0, self.a1
+
+
+@njit(cache=True, error_model="numpy")
+def _solve_into(m, rhs, out):
+    """``out[s, r] = m[s]^-1 rhs[s, r]`` by LU with partial pivoting; False where an ``m[s]`` is singular."""
+    count, n = m.shape[0], m.shape[1]
+    b = np.empty((n, n))
+    piv = np.empty(n, dtype=np.int64)
+    x = np.empty(n)
+    for s in range(count):
+        b[:, :] = m[s]
+        if _lu(b, n, piv, 0.0):
+            return False
+        for r in range(rhs.shape[1]):
+            for c in range(n):
+                for i in range(n):
+                    x[i] = rhs[s, r, i, c]
+                _lu_solve(b, n, piv, x)
+                for i in range(n):
+                    out[s, r, i, c] = x[i]
+    return True
+
+
+def mass_solve(m: Array, rhs: Array) -> Array:
+    """``m^-1 rhs`` for stacks ``m (J, n, n)``, ``rhs (J, r, n, n)``: compiled, one call for a batch.
+
+    The operators of affine problems (``M^-1 K0``, ``M^-1 K1``; ``E^-1 A0``, ``E^-1 A1``) come from
+    here, for one model and for a design study alike. Raises ``numpy.linalg.LinAlgError`` for a
+    singular matrix.
+    """
+    out = np.empty(rhs.shape)
+    if not _solve_into(np.ascontiguousarray(m, dtype=float), np.ascontiguousarray(rhs, dtype=float), out):
+        raise np.linalg.LinAlgError("Singular matrix")
+    return out
+
+
+class _SecondOrderProvider:
+    """Operators of a second-order family that is not affine (``family.matrices`` per load)."""
+
+    def __init__(self, family, undamped: bool) -> None:
+        self.family = family
+        self.undamped = undamped
+        self.error: BaseException | None = None
+        self._mass: dict[float, Array] = {}
+
+    def operators(self, loads: Array) -> Array:
+        m, d, g, k = self.family.matrices(np.asarray(loads, dtype=float))
+        n = m.shape[-1]
+        size = n if self.undamped else 2 * n
+        out = np.full((len(loads), size, size), np.nan)
+        good = np.isfinite(m).all(axis=(1, 2)) & np.isfinite(k).all(axis=(1, 2)) & np.isfinite(d + g).all(axis=(1, 2))
+        if good.any():
+            if self.undamped:
+                out[good] = np.linalg.solve(m[good], k[good])
+            else:
+                out[good] = state_matrices(m[good], (d + g)[good], k[good])
+        for p, mm in zip(loads, m):
+            self._mass[float(p)] = np.diag(mm).copy()
+        if len(self._mass) > 4096:
+            self._mass.clear()
+        return out
+
+    def weights(self, p: float) -> Array:
+        hit = self._mass.get(float(p))
+        if hit is None:
+            hit = np.diag(self.family.matrices(np.array([p]))[0][0]).copy()
+        return hit
+
+    def fold_indicator(self, p: float) -> float:
+        m, _, _, k = self.family.matrices(np.array([p]))
+        if not np.isfinite(k).all():
+            return np.nan
+        s = np.linalg.eigvals(np.linalg.solve(m[0], k[0]))
+        return float(np.min(np.abs(s)) ** 2)
+
+
+class _FirstOrderProvider:
+    """Operators ``E^-1 A(p)`` of a first-order family that is not affine."""
+
+    def __init__(self, family) -> None:
+        self.family = family
+        self.error: BaseException | None = None
+        self._weights = np.asarray(getattr(family, "weights", None) if getattr(family, "weights", None) is not None
+                                   else np.ones(family.n_dof), dtype=float)
+
+    def operators(self, loads: Array) -> Array:
+        e, a = self.family.matrices(np.asarray(loads, dtype=float))
+        out = np.full(a.shape, np.nan)
+        good = np.isfinite(e).all(axis=(1, 2)) & np.isfinite(a).all(axis=(1, 2))
+        if good.any():
+            out[good] = np.linalg.solve(e[good], a[good])
+        return out
+
+    def weights(self, p: float) -> Array:
+        return self._weights
+
+    def fold_indicator(self, p: float) -> float:
+        op = self.operators(np.array([p]))[0]
+        if not np.isfinite(op).all():
+            return np.nan
+        return float(np.min(np.abs(np.linalg.eigvals(op))) ** 2)
+
+
+def _range(family, p_min: float, p_max: float, n_scan: int):
+    if not (np.isfinite(p_max) and np.isfinite(p_min) and p_max > p_min):
+        raise ValueError(f"p_max = {p_max!r}: must be finite and above p_min = {p_min!r}")
+    if int(n_scan) < 1:
+        raise ValueError(f"n_scan = {n_scan!r}: must be at least 1")
+    return float(p_min), float(p_max), int(n_scan)
+
+
+def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: int = 64,
+                         undamped: bool | None = None) -> Problem:
+    """The problem of a second-order family ``p -> (M, D, G, K)`` (:class:`~impstab.linear.SystemFamily`).
+
+    ``undamped`` forces the undamped (``s``) or the first-order form; by default the undamped form
+    is used where D and G vanish (affine families: exactly; others: at ``p_min``, the middle and
+    ``p_max``, since damping and gyroscopic terms may follow the load).
+    """
+    p_min, p_max, n_scan = _range(family, p_min, p_max, n_scan)
+    parts = family.affine_parts() if hasattr(family, "affine_parts") else None
+    if parts is not None:
+        parts = [np.asarray(x, dtype=float) for x in parts]
+        d, g = parts[1], parts[2]
+    else:
+        _, d, g, _ = family.matrices(np.array([p_min, 0.5 * (p_min + p_max), p_max]))
+    if undamped is None:
+        undamped = not (d.any() or g.any())
+    n = int(family.n)
+    if parts is None:
+        return Problem(bool(undamped), p_min, p_max, n_scan, n if undamped else 2 * n, n,
+                       provider=_SecondOrderProvider(family, bool(undamped)))
+    m, d, g, k0, k1 = parts
+    if undamped:
+        problem = Problem(True, p_min, p_max, n_scan, n, n, weights=m.diagonal().copy(), second_order=(m, k0, k1))
+        if n <= LARGE_ORDER:  # a large one may be reduced: its operators are formed only if needed
+            problem.operators()
+        return problem
+    else:
+        a0 = state_matrices(m, d + g, k0)
+        a1 = np.zeros_like(a0)
+        a1[n:, :n] = -np.linalg.solve(m, k1)
+    return Problem(False, p_min, p_max, n_scan, a0.shape[0], n, a0, a1, np.diag(m).copy())
+
+
+def first_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: int = 64) -> Problem:
+    """The problem of a first-order family ``E x' = A(p) x`` (:class:`~impstab.linear.FirstOrderFamily`)."""
+    p_min, p_max, n_scan = _range(family, p_min, p_max, n_scan)
+    n = int(family.n)
+    n_dof = int(getattr(family, "n_dof", n) or n)
+    parts = family.affine_parts() if hasattr(family, "affine_parts") else None
+    if parts is None:
+        return Problem(False, p_min, p_max, n_scan, n, n_dof, provider=_FirstOrderProvider(family))
+    e, a0, a1 = (np.asarray(x, dtype=float) for x in parts)
+    a0, a1 = mass_solve(e[None], np.array([[a0, a1]]))[0]
+    weights = getattr(family, "weights", None)
+    weights = np.ones(n_dof) if weights is None else np.asarray(weights, dtype=float)
+    return Problem(False, p_min, p_max, n_scan, n, n_dof, a0, a1, weights.copy())

@@ -1,0 +1,693 @@
+"""Exact refinement of every bracket (compiled), and the onset values there (THEORY 5).
+
+A bracket ``(a, b)`` has ``a`` stable and ``b`` unstable by the classification, whose thresholds
+only bracket. The onset itself is the root of a smooth indicator that crosses zero linearly:
+
+* the cluster going unstable at ``b`` (two eigenvalues, or four where two symmetric planes merge
+  at once) is followed across the bracket by its oblique spectral projector ``V_C W_C^H``
+  (``W^H = V^-1``), which picks the ``k`` eigenvectors at a load lying most in it;
+* undamped second-order problems (``s = omega^2``): ``Delta = k sum s_i^2 - (sum s_i)^2`` of the
+  cluster, a symmetric function analytic in the load although the double root is defective
+  (its eigenvalues carry sqrt(eps) noise, ``Delta`` only eps): positive while the cluster is real,
+  negative once it is a complex pair; divergence: the cluster mean of ``s``;
+* first-order problems (``lambda``): the largest real part of the cluster from its symmetric
+  functions (``Re c + |Re sqrt(d)|`` with the mean ``c`` and variance ``d`` of the upper half, a
+  Hopf crossing). Where the merging branches lay on the imaginary axis before (an undamped
+  system in first-order form, an undamped gyroscopic one), the discriminant of the cluster's
+  upper half, ``Re(m sum lambda^2 - (sum lambda)^2)``, which crosses zero linearly like
+  ``Delta``; a branch leaving the axis through zero leaves like ``sqrt(p - p_c)``, and its onset
+  is where it is off the axis by the classification tolerance (an error of order 1e-14).
+
+Affine problems use the exact derivative of the indicator (eigenvalue derivatives
+``W_C A1 V_C``) in a bracketed Newton iteration from the root of the Hermite cubic through the
+indicator and its slope at both ends; the others scipy's Brent method (``brentq``, ported as
+steps). Where the cluster at ``b`` is not clearly one at ``a``, the bracket is halved
+on the classification and tried again; where the indicator shows ``a`` already past the onset,
+``a`` steps back by the bracket width. Where the exact route cannot be used at all, the bracket
+is narrowed on the classification alone and the result carries a warning.
+"""
+
+from __future__ import annotations
+
+from math import sqrt
+
+import numpy as np
+from numba import njit
+
+from ..classify import _masks
+from ..participation import participation_into
+from .layout import (AFFINE, BISECTIONS, BRACKETS, DECOMPOSITIONS, DIRECTION, EVALUATIONS, FIRST, FORM, HI, KEY, KIND, LO, LOAD,
+                     OMEGA, START_UNSTABLE, STATUS, WARNED)
+from .scan import _classify
+from .spectra import FAILED, NOT_FINITE, OK, PROVIDER_ERROR, cache_new, provided_weights, spectrum, workspace
+from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
+
+__all__ = ["refine_stack"]
+
+#: onset kinds; a limit point still to be located by the caller (its bracket is returned)
+FLUTTER, DIVERGENCE, LIMIT = 1, 2, 3
+_EPS4 = 4.0 * EPS
+
+
+# -- the cluster ------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def _relative_real(v):
+    mag = abs(v)
+    return v.real / mag if mag > 0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def unstable_cluster(vals, undamped, members, cplx, neg):
+    """The cluster that is unstable into the mask ``members``; returns ``(found, unique, divergence)``.
+
+    ``unique``: every unstable eigenvalue is in the cluster. ``cplx, neg`` are ``(1, n)`` work arrays.
+    """
+    n = vals.shape[0]
+    _masks(vals.reshape(1, n), undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR, cplx, neg)
+    j0 = -1
+    divergence = False
+    if undamped:
+        for i in range(n):
+            if cplx[0, i] and (j0 < 0 or vals[i].real < vals[j0].real):
+                j0 = i
+        if j0 < 0:
+            divergence = True
+            for i in range(n):
+                if neg[0, i] and (j0 < 0 or vals[i].real < vals[j0].real):
+                    j0 = i
+    else:
+        best = -np.inf
+        for i in range(n):
+            if cplx[0, i] or neg[0, i]:
+                r = _relative_real(vals[i])
+                if j0 < 0 or r > best:
+                    j0, best = i, r
+        if j0 >= 0:
+            divergence = neg[0, j0]
+    if j0 < 0:
+        members[:] = True
+        return False, False, False
+    ref = vals[j0]
+    big = 0.0
+    for v in vals:
+        big = max(big, abs(v))
+    tol = max(TOL_CLUSTER * abs(ref), FLOOR * big)
+    unique = True
+    for i in range(n):
+        v = vals[i]
+        close = abs(v - ref) <= tol or abs(v - ref.conjugate()) <= tol
+        if not undamped and not divergence:
+            # the decaying partner of a merged pair has the same frequency: keep it in the
+            # cluster (before the merge the two modes span both branches)
+            close = close or abs(abs(v.imag) - abs(ref.imag)) <= tol
+        members[i] = close
+        if (cplx[0, i] or neg[0, i]) and not close:
+            unique = False
+    return True, unique, divergence
+
+
+@njit(cache=True, error_model="numpy")
+def projector(vecs, inv, members, vc, wc):
+    """The cluster's oblique projector ``V_C W_C^H`` as ``vc (n, k)``, ``wc (k, n)``; returns ``k``."""
+    n = vecs.shape[0]
+    k = 0
+    for c in range(n):
+        if members[c]:
+            for r in range(n):
+                vc[r, k] = vecs[r, c]
+                wc[k, r] = inv[c, r]
+            k += 1
+    return k
+
+
+@njit(cache=True, error_model="numpy")
+def select(vecs, vc, wc, k, sel, share):
+    """The ``k`` eigenvectors lying most in the cluster subspace into ``sel[:k]``; whether clear.
+
+    ``vecs`` are unit columns; the share of each is the squared norm of its oblique projection
+    onto the cluster subspace; clear when the ``k``-th share exceeds 1/4 and the next is below.
+    """
+    n = vecs.shape[0]
+    t = np.empty(k, dtype=np.complex128)
+    for c in range(n):
+        for i in range(k):
+            s = 0j
+            for r in range(n):
+                s += wc[i, r] * vecs[r, c]
+            t[i] = s
+        total = 0.0
+        for r in range(n):
+            y = 0j
+            for i in range(k):
+                y += vc[r, i] * t[i]
+            total += y.real * y.real + y.imag * y.imag
+        share[c] = total
+    order = np.argsort(-share[:n], kind="mergesort")
+    for i in range(k):
+        sel[i] = order[i]
+    return share[order[k - 1]] > 0.25 and (n == k or share[order[k]] < 0.25)
+
+
+@njit(cache=True, error_model="numpy")
+def _pair_growth(v, k):
+    """Largest real part of a cluster (upper half plane), from its symmetric functions.
+
+    For the upper-half members (a pair, possibly each doubled by symmetry) ``c = mean`` and
+    ``d = mean((lambda - c)^2)`` are analytic in the load even where the pair is defective, so
+    ``Re c + |Re sqrt(d)|`` keeps its accuracy there; for a single eigenvalue it is ``Re lambda``.
+    """
+    upper = False
+    for i in range(k):
+        upper = upper or v[i].imag > 0
+    c = 0j
+    m = 0
+    for i in range(k):
+        if not upper or v[i].imag >= 0:
+            c += v[i]
+            m += 1
+    c /= m
+    d = 0j
+    for i in range(k):
+        if not upper or v[i].imag >= 0:
+            d += (v[i] - c) ** 2
+    d /= m
+    return c.real + abs(np.sqrt(d).real)
+
+
+@njit(cache=True, error_model="numpy")
+def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, derivative, sel, share, coalesce=False):
+    """``(f, df, clear)``: the exact indicator of the cluster in the decomposition, its derivative.
+
+    ``df`` (affine problems, ``derivative``) from the eigenvalue derivatives ``W_C A1 V_C``;
+    ``clear`` False where the cluster is not found clearly (then the values mean nothing).
+    ``coalesce`` (first-order problems whose crossing branch lay on the imaginary axis): the
+    discriminant of the cluster's upper half, ``Re(m sum lambda^2 - (sum lambda)^2)``, negative
+    while two frequencies ``i w_1, i w_2`` are distinct, positive once they have split into
+    ``+-a + i b``, and like the undamped ``Delta`` analytic through the defective double root.
+    """
+    if not select(vecs, vc, wc, k, sel, share):
+        return 0.0, 0.0, False
+    v = np.empty(k, dtype=np.complex128)
+    for i in range(k):
+        v[i] = vals[sel[i]]
+    jj = 0
+    half = np.ones(k, dtype=np.bool_)
+    if coalesce:
+        upper = False
+        for i in range(k):
+            upper = upper or v[i].imag > 0
+        for i in range(k):
+            half[i] = not upper or v[i].imag >= 0
+    if undamped or coalesce:
+        s1 = 0j
+        s2 = 0j
+        m = 0
+        for i in range(k):
+            if half[i]:
+                s1 += v[i]
+                s2 += v[i] * v[i]
+                m += 1
+        f = s1.real / k if divergence else (m * s2 - s1 * s1).real
+    else:
+        best = -np.inf
+        for i in range(k):
+            r = _relative_real(v[i])
+            if r > best:
+                jj, best = i, r
+        f = _pair_growth(v, k) - target * abs(v[jj])
+    if not derivative:
+        return f, 0.0, True
+    n = vecs.shape[0]
+    b = np.empty(k, dtype=np.complex128)
+    for i in range(k):
+        c0 = sel[i]
+        acc = 0j
+        for r in range(n):
+            w = inv[c0, r]
+            if w == 0:
+                continue
+            row = 0j
+            for c in range(n):
+                row += a1[r, c] * vecs[c, c0]
+            acc += w * row
+        b[i] = acc
+    if not (undamped or coalesce):
+        return f, b[jj].real, True
+    if divergence:
+        df = 0.0
+        for i in range(k):
+            df += b[i].real
+        return f, df / k, True
+    s1 = 0j
+    sb = 0j
+    svb = 0j
+    m = 0
+    for i in range(k):
+        if half[i]:
+            s1 += v[i]
+            sb += b[i]
+            svb += v[i] * b[i]
+            m += 1
+    return f, (2 * m * svb - 2 * s1 * sb).real, True
+
+
+# -- roots, as steps (reverse communication) ------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def hermite_root(a, b, fa, fb, da, db):
+    """A first point for Newton: the root in ``(a, b)`` of the cubic with ``f`` and ``f'`` at both ends.
+
+    Its error is of order ``h^4`` against the secant's ``h^2``; the secant point where the slopes
+    are not known or the cubic has no root inside.
+    """
+    secant = a - fa * (b - a) / (fb - fa)
+    if np.isnan(da) or np.isnan(db):
+        return secant
+    h = b - a
+    # the cubic in t = (x - a) / h with value and slope (times h) at t = 0 and 1
+    c0, c1 = fa, da * h
+    c2 = 3 * (fb - fa) - (2 * da + db) * h
+    c3 = 2 * (fa - fb) + (da + db) * h
+    t = (secant - a) / h
+    lo, hi = 0.0, 1.0
+    for _ in range(30):  # safeguarded Newton on the cubic (a few scalar steps)
+        f = c0 + t * (c1 + t * (c2 + t * c3))
+        if f == 0.0:
+            break
+        if (f > 0) == (fa > 0):
+            lo = t
+        else:
+            hi = t
+        d = c1 + t * (2 * c2 + 3 * t * c3)
+        step = f / d if d != 0.0 else np.inf
+        new = t - step
+        if not (lo < new < hi):
+            new = 0.5 * (lo + hi)
+        if abs(new - t) <= 1e-15:
+            t = new
+            break
+        t = new
+    x = a + t * h
+    return x if min(a, b) < x < max(a, b) else secant
+
+
+@njit(cache=True, error_model="numpy")
+def newton_step(st, p, f, df):
+    """Bracketed Newton (bisection guard) after ``f, df`` at ``p``; returns ``(next, done)``.
+
+    ``st = (lo, hi, f_lo, last Newton step or NaN)``: the bracket, updated here. Done when the
+    step is below 4 eps, or lands on an end of the bracket, or when the convergence seen so far
+    is clearly quadratic (the step shrank by 1e4 at least) and predicts the error of the next
+    point below eps: the error after a step ``d`` is ``C d^2``, ``C`` measured as
+    ``|d| / d_prev^2`` from the last two steps. (The indicators cross zero linearly: simple roots.)
+    """
+    if f == 0.0:
+        return p, True
+    if np.sign(f) == np.sign(st[2]):
+        st[0], st[2] = p, f
+    else:
+        st[1] = p
+    lo, hi = st[0], st[1]
+    new = p - f / df if df != 0.0 else np.inf
+    prev = st[3]
+    st[3] = new - p
+    if not (min(lo, hi) < new < max(lo, hi)):
+        new = 0.5 * (lo + hi)
+        st[3] = np.nan
+    step = abs(new - p)
+    if step <= _EPS4 * abs(p) or new == lo or new == hi:
+        return new, True
+    quadratic = not np.isnan(prev) and not np.isnan(st[3]) and step <= 1e-4 * abs(prev)
+    return new, quadratic and (step / (prev * prev)) * step * step <= EPS * abs(new)
+
+
+@njit(cache=True, error_model="numpy")
+def brent_step(st, f):
+    """scipy's ``brentq`` (xtol 1e-300, rtol 4 eps) as steps; returns ``(x, done)``.
+
+    ``st = (xpre, xcur, xblk, fpre, fcur, fblk, spre, scur)``; ``f`` is the value at the last
+    point returned (NaN on the first call, which starts from ``xpre, xcur, fpre, fcur``).
+    """
+    xtol, rtol = 1e-300, _EPS4
+    xpre, xcur, xblk, fpre, fcur, fblk, spre, scur = st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]
+    if not np.isnan(f):
+        fcur = f
+    if fpre != 0 and fcur != 0 and (np.signbit(fpre) != np.signbit(fcur)):
+        xblk, fblk = xpre, fpre
+        spre = scur = xcur - xpre
+    if abs(fblk) < abs(fcur):
+        xpre, xcur, xblk = xcur, xblk, xcur
+        fpre, fcur, fblk = fcur, fblk, fcur
+    delta = (xtol + rtol * abs(xcur)) / 2
+    sbis = (xblk - xcur) / 2
+    done = fcur == 0 or abs(sbis) < delta
+    if not done:
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:  # interpolate
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:  # extrapolate
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2 * abs(stry) < min(abs(spre), 3 * abs(sbis) - delta):
+                spre, scur = scur, stry
+            else:
+                spre, scur = sbis, sbis
+        else:
+            spre, scur = sbis, sbis
+        xpre, fpre = xcur, fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0 else -delta
+    st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7] = xpre, xcur, xblk, fpre, fcur, fblk, spre, scur
+    return xcur, done
+
+
+# -- onset values -------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def onset_values(vals, vecs, members, k, undamped, divergence, shapes, values, weights, mode, part, coalesce=False):
+    """Kind and omega of the onset, its mode (largest component 1) and participation.
+
+    ``vals, vecs``: the decomposition at the onset, ``members[:k]`` the cluster's columns;
+    ``shapes (n, k), values (k,)``: the distinct modes the participation is taken from. Where two
+    frequencies merge (undamped, or ``coalesce``: first order on the imaginary axis) omega comes
+    from the cluster's mean, a symmetric function: the individual eigenvalues of the defective
+    double root carry sqrt(eps) noise, their mean only eps.
+    """
+    n = mode.shape[0]
+    lead = members[0]
+    if undamped:
+        omega = 0.0
+        if not divergence:
+            mean = 0.0
+            for i in range(k):
+                mean += vals[members[i]].real
+                if abs(vals[members[i]].imag) > abs(vals[lead].imag):
+                    lead = members[i]
+            omega = sqrt(max(mean / k, 0.0))
+    else:
+        for i in range(k):
+            if vals[members[i]].real > vals[lead].real:
+                lead = members[i]
+        omega = 0.0 if divergence else abs(vals[lead].imag)
+        if coalesce:
+            mean = 0.0
+            m = 0
+            for i in range(k):
+                if vals[members[i]].imag >= 0:
+                    mean += vals[members[i]].imag
+                    m += 1
+            omega = mean / max(m, 1)
+    big = 0
+    for r in range(n):
+        mode[r] = vecs[r, lead]
+        if abs(mode[r]) > abs(mode[big]):
+            big = r
+    scale = mode[big].conjugate() / (abs(mode[big]) ** 2)
+    for r in range(n):
+        mode[r] *= scale
+    # each distinct mode of the cluster weighs equally in the participation
+    participation_into(shapes, values, np.ones(k, dtype=np.bool_), weights, TOL_DUPLICATE, part)
+    return (DIVERGENCE if divergence else FLUTTER), omega
+
+
+@njit(cache=True, error_model="numpy")
+def _take(vals, vecs, cols, k, n):
+    """``(vecs[:n, cols[:k]], vals[cols[:k]])``, new arrays."""
+    shapes = np.empty((n, k), dtype=np.complex128)
+    values = np.empty(k, dtype=np.complex128)
+    for i in range(k):
+        values[i] = vals[cols[i]]
+        for r in range(n):
+            shapes[r, i] = vecs[r, cols[i]]
+    return shapes, values
+
+
+# -- every bracket of every problem ---------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def refine_stack(jobs, onsets, mode_out, part_out, counts):
+    """Refine every bracket of every problem: the onsets into ``onsets``, the first loss's mode
+    and participation into ``mode_out``, ``part_out`` (:mod:`impstab.linear.engine.layout`).
+
+    A limit point gets kind :data:`LIMIT` and its final bracket in ``LO, HI``, for the caller to
+    locate. A problem unstable at the start gets its onset values there in row 0.
+    """
+    n = jobs.a0.shape[1]
+    n_dof = mode_out.shape[1]
+    ws = workspace(n, 1)
+    cache = cache_new(n)
+    vc = np.empty((n, n), dtype=np.complex128)
+    wc = np.empty((n, n), dtype=np.complex128)
+    sel = np.empty(n, dtype=np.int64)
+    cols = np.empty(n, dtype=np.int64)
+    share = np.empty(n)
+    members = np.empty(n, dtype=np.bool_)
+    cplx = np.empty((1, n), dtype=np.bool_)
+    neg = np.empty((1, n), dtype=np.bool_)
+    one_flag = np.zeros(1, dtype=np.bool_)
+    one_ind = np.zeros((1, 2))
+    weights = np.empty(n_dof)
+    mode = np.empty(n_dof, dtype=np.complex128)
+    part = np.empty(n_dof)
+    point = np.zeros(1)
+    st = np.zeros(8)
+    ev = np.zeros(3, dtype=np.int64)
+    for j in range(len(jobs.ints)):
+        if counts[j, STATUS] != 0:
+            continue
+        cache[0][:] = np.nan
+        ev[:] = 0
+        undamped = jobs.ints[j, FORM] == 0
+        affine = jobs.ints[j, AFFINE] == 1
+        start_unstable = counts[j, START_UNSTABLE] == 1
+        lo_lim, hi_lim = jobs.span[j, 0], jobs.span[j, 1]
+        a1 = jobs.a1[j]
+        failed = False
+        first = -1
+        tasks = 1 if start_unstable else counts[j, BRACKETS]
+        for t in range(tasks):
+            if start_unstable:
+                a, b = np.nan, jobs.grids[j, 0]
+            else:
+                a, b = onsets[j, t, LO], onsets[j, t, HI]
+            onsets[j, t, DIRECTION] = 1.0 if not a > b else -1.0
+            root = np.nan
+            warned = False
+            limit = False
+            divergence = False
+            k = 0
+            shapes = np.empty((n_dof, 1), dtype=np.complex128)
+            values = np.empty(1, dtype=np.complex128)
+            vals_r = np.empty(n, dtype=np.complex128)
+            vecs_r = np.empty((n, n), dtype=np.complex128)
+            last = np.nan
+            coalesce = False
+            steps = 0 if start_unstable else 200
+            for _ in range(steps):
+                point[0] = b
+                code_b, sb = spectrum(jobs, j, point, True, cache, ws, ev)
+                if code_b == PROVIDER_ERROR:
+                    failed = True
+                    break
+                if code_b == NOT_FINITE:
+                    # no static equilibrium at b: close in on the limit point
+                    mid = 0.5 * (a + b)
+                    if mid == a or mid == b:
+                        limit = True
+                        break
+                    point[0] = mid
+                    if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
+                        failed = True
+                        break
+                    _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
+                    if one_flag[0]:
+                        b = mid
+                    else:
+                        a = mid
+                    continue
+                found, unique, divergence = unstable_cluster(cache[2][sb], undamped, members, cplx, neg)
+                step_back = False
+                if found and code_b == OK:
+                    k = projector(cache[3][sb], cache[4][sb], members, vc, wc)
+                    point[0] = a
+                    code_a, sa = spectrum(jobs, j, point, True, cache, ws, ev)
+                    if code_a == PROVIDER_ERROR:
+                        failed = True
+                        break
+                    ok_a = code_a != NOT_FINITE and select(cache[3][sa], vc, wc, k, sel, share)
+                    while unique and ok_a:  # the exact route (a loop only to leave it early)
+                        target = 0.0
+                        coalesce = False
+                        if not undamped:
+                            # on the imaginary axis (to rounding) at a and a step before it? Then two
+                            # frequencies merge there (the discriminant of the cluster's upper half
+                            # crosses zero linearly), or a branch leaves through zero
+                            marginal = True
+                            for p in (a, min(max(a + (a - b), lo_lim), hi_lim)):
+                                point[0] = p
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                if code == PROVIDER_ERROR:
+                                    failed = True
+                                    break
+                                if code == NOT_FINITE or not select(cache[3][s], vc, wc, k, sel, share):
+                                    marginal = False
+                                    break
+                                for i in range(k):
+                                    if abs(_relative_real(cache[2][s][sel[i]])) > TOL_MARGINAL:
+                                        marginal = False
+                                if not marginal:
+                                    break
+                            if failed:
+                                break
+                            if marginal and divergence:
+                                # the branch leaves the axis through zero like sqrt(p - p_c): the onset
+                                # is where it is off the axis by TOL_UNSTABLE
+                                target = TOL_UNSTABLE
+                            coalesce = marginal and not divergence
+                        newton = affine and target == 0.0 and (undamped or k <= 2 or coalesce)
+                        fab = np.zeros(2)
+                        dfab = np.full(2, np.nan)
+                        clear = True
+                        for e in range(2):
+                            point[0] = a if e == 0 else b
+                            code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                            if code == PROVIDER_ERROR:
+                                failed = True
+                                break
+                            slope = newton and code == OK
+                            f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
+                                                  divergence, target, slope, sel, share, coalesce)
+                            clear = clear and code != NOT_FINITE and ok
+                            fab[e] = f
+                            if slope:
+                                dfab[e] = df
+                        if failed or not clear:
+                            break
+                        fa, fb = fab[0], fab[1]
+                        if fa == 0.0:
+                            root = a
+                        elif np.sign(fa) == np.sign(fb):
+                            step_back = True
+                            break
+                        elif newton:
+                            st[0], st[1], st[2], st[3] = a, b, fa, np.nan
+                            p = hermite_root(a, b, fa, fb, dfab[0], dfab[1])
+                            for _ in range(100):
+                                point[0] = last = p
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                if code == PROVIDER_ERROR:
+                                    failed = True
+                                    break
+                                if code != OK:
+                                    break
+                                f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc,
+                                                      k, divergence, 0.0, True, sel, share, coalesce)
+                                if not ok:
+                                    break
+                                p, done = newton_step(st, p, f, df)
+                                if done:
+                                    root = p
+                                    break
+                        else:
+                            st[0], st[1], st[3], st[4] = a, b, fa, fb
+                            st[2] = st[5] = st[6] = st[7] = 0.0
+                            f = np.nan
+                            for _ in range(200):
+                                x, done = brent_step(st, f)
+                                if done:
+                                    root = x
+                                    break
+                                point[0] = last = x
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                if code == PROVIDER_ERROR:
+                                    failed = True
+                                    break
+                                f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
+                                                     divergence, target, False, sel, share, coalesce)
+                                if code == NOT_FINITE or not ok:
+                                    break
+                        break
+                    if failed:
+                        break
+                    if not np.isnan(root):
+                        # the onset values: cluster at the root (or at the last point evaluated, where
+                        # that is within 1e-12 of it), distinct modes at a (stable side)
+                        point[0] = last if abs(root - last) <= 1e-12 * abs(root) else root
+                        code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                        if code == PROVIDER_ERROR:
+                            failed = True
+                            break
+                        select(cache[3][s], vc, wc, k, sel, share)
+                        cols[:k] = sel[:k]
+                        shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
+                        vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
+                        point[0] = a
+                        code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                        if code == PROVIDER_ERROR:
+                            failed = True
+                            break
+                        if code != NOT_FINITE and select(cache[3][s], vc, wc, k, sel, share):
+                            shapes, values = _take(cache[2][s], cache[3][s], sel, k, n_dof)
+                        break
+                    if step_back:
+                        new_a = min(max(a + (a - b), lo_lim), hi_lim)
+                        if new_a == a:
+                            break
+                        a = new_a
+                        continue
+                mid = 0.5 * (a + b)
+                if mid == a or mid == b:
+                    break
+                point[0] = mid
+                if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
+                    failed = True
+                    break
+                _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
+                counts[j, BISECTIONS] += 1
+                if one_flag[0]:
+                    b = mid
+                else:
+                    a = mid
+            if failed:
+                break
+            if limit:
+                onsets[j, t, KIND], onsets[j, t, LOAD] = LIMIT, b
+                onsets[j, t, LO], onsets[j, t, HI] = a, b
+                continue
+            if np.isnan(root):
+                # the exact indicator could not be used (or the problem is unstable at the start):
+                # the onset values at b, from its unstable cluster
+                warned = not start_unstable
+                coalesce = False
+                root = b
+                point[0] = b
+                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                if code == PROVIDER_ERROR:
+                    failed = True
+                    break
+                found, _, divergence = unstable_cluster(cache[2][s], undamped, members, cplx, neg)
+                k = 0
+                for i in range(n):
+                    if members[i]:
+                        cols[k] = i
+                        k += 1
+                shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
+                vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
+            if affine or jobs.ints[j, KEY] < 0:
+                weights[:] = jobs.weights[j]
+            elif provided_weights(jobs.ints[j, KEY], root, weights) != 0:
+                failed = True
+                break
+            kind, omega = onset_values(vals_r, vecs_r, cols, k, undamped, divergence, shapes, values, weights, mode,
+                                       part, coalesce)
+            onsets[j, t, LOAD], onsets[j, t, KIND], onsets[j, t, OMEGA] = root, kind, omega
+            onsets[j, t, WARNED] = 1.0 if warned else 0.0
+            if start_unstable or (a < b and (first < 0 or root < onsets[j, first, LOAD])):
+                first = t
+                mode_out[j, :] = mode
+                part_out[j, :] = part
+        counts[j, EVALUATIONS] += ev[0]
+        counts[j, DECOMPOSITIONS] += ev[1]
+        counts[j, FIRST] = first
+        if failed:
+            counts[j, STATUS] = 1
