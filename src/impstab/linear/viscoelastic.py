@@ -1,0 +1,257 @@
+"""Linear analyses of a model with viscoelastic mounts: the augmented first-order system.
+
+Each Prony term j of mount i adds an internal 3-vector ``z_ij`` (hull frame, m). Linearized at
+the static equilibrium (where ``z_ij = d_i``, so the static stiffness carries the load), with
+``B_i = [I, -S(rho_i)]`` (3 x 6, ``rho_i = R0 r_i`` the arm at equilibrium) and ``k_i`` the
+mount's static 3 x 3 translation stiffness:
+
+    M q'' + (D + G) q' + (K + sum_ij g_ij B_i^T k_i B_i) q - sum_ij g_ij B_i^T k_i z_ij = 0
+    tau_ij z_ij' = B_i q - z_ij
+
+(K, D, G, M the elastic model's tangent matrices at that equilibrium). As ``E x' = A(T) x`` with
+``x = (q, q', z)``: ``E = diag(I, M, I)`` and 12 + 3 x (terms) x (mounts) states. Eliminating
+``z = B q / (1 + lambda tau)`` gives the exact nonlinear eigenproblem
+
+    det(lambda^2 M + lambda (D + G) + K + sum_i B_i^T k_i B_i (r_i(lambda) - 1)) = 0
+
+with the mount's ratio ``r_i = k*/k0`` (:mod:`impstab.model.viscoelastic`). The engine
+(:mod:`impstab.linear.engine`) solves the augmented family; :func:`exact_onset` then solves the
+nonlinear eigenproblem with the law itself (not its Prony fit) at the onset by Newton on
+``(T, omega)`` with ``lambda = i omega``, which checks (and for a fitted law, corrects) it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..kinematics import rigid_map
+from ..model.model import Model
+from ..model.viscoelastic import prony_ratio
+from .linearize import ModelFamily
+
+__all__ = ["ViscoelasticFamily", "ExactOnset", "exact_onset", "augmented_matrices", "dynamic_stiffness"]
+
+Array = NDArray[np.float64]
+
+#: Newton on the exact eigenproblem stops when the step is below this (relative)
+NEWTON_TOL = 1e-12
+NEWTON_MAX = 40
+#: a last step below this (relative) after NEWTON_MAX steps is converged to rounding
+NEWTON_FLOOR = 1e-9
+
+
+def _terms(model: Model):
+    """``(mount index, static 3x3 k, g (n,), tau (n,))`` of every viscoelastic mount."""
+    out = []
+    for i, m in enumerate(model.mounts):
+        if m.viscoelastic is not None:
+            out.append((i, np.array(m.stiffness[:3, :3]), m.viscoelastic.weights, m.viscoelastic.relaxation_times))
+    return out
+
+
+def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms) -> tuple[Array, Array]:
+    """``E, A`` of the augmented state for stacks ``m, c = D + G, k (S, 6, 6)`` and arms ``rho (S, nm, 3)``.
+
+    ``terms`` as :func:`_terms` returns. Returns ``E, A (S, N, N)``, ``N = 12 + 3 sum n_i``.
+    """
+    s = m.shape[0]
+    nz = 3 * sum(len(g) for _, _, g, _ in terms)
+    n = 12 + nz
+    e = np.zeros((s, n, n))
+    a = np.zeros((s, n, n))
+    e[:, :6, :6] = np.eye(6)
+    e[:, 6:12, 6:12] = m
+    e[:, 12:, 12:] = np.eye(nz)
+    a[:, :6, 6:12] = np.eye(6)
+    a[:, 6:12, 6:12] = -c
+    kk = np.array(k, dtype=float, copy=True)
+    row = 12
+    for i, kmount, g, tau in terms:
+        b = rigid_map(rho[:, i])                       # (S, 3, 6)
+        kb = kmount[None] @ b                          # (S, 3, 6)
+        btk = np.swapaxes(b, -1, -2) @ kmount[None]    # (S, 6, 3)
+        for gj, tj in zip(g, tau):
+            kk += gj * np.swapaxes(b, -1, -2) @ kb
+            a[:, 6:12, row:row + 3] = gj * btk
+            a[:, row:row + 3, :6] = b / tj
+            a[:, row:row + 3, row:row + 3] = -np.eye(3) / tj
+            row += 3
+    a[:, 6:12, :6] = -kk
+    return e, a
+
+
+def dynamic_stiffness(lam: complex, m, c, k, rho, model: Model, exact: bool = True) -> Array:
+    """``lambda^2 M + lambda (D + G) + K + sum_i B_i^T k_i B_i (r_i(lambda) - 1)`` (6 x 6, complex).
+
+    ``exact`` uses each mount's law; otherwise its Prony series.
+    """
+    f = lam * lam * m + lam * c + k + 0j
+    for i, kmount, g, tau in _terms(model):
+        law = model.mounts[i].viscoelastic
+        b = rigid_map(rho[i])
+        r = law.ratio_at(lam) if exact else prony_ratio(lam, g, tau)
+        f = f + b.T @ kmount @ b * (complex(r) - 1.0)
+    return f
+
+
+def _d_dynamic_stiffness(lam: complex, m, c, rho, model: Model) -> Array:
+    """``dF / d lambda`` with the exact laws."""
+    f = 2.0 * lam * m + c + 0j
+    for i, kmount, _, _ in _terms(model):
+        b = rigid_map(rho[i])
+        f = f + b.T @ kmount @ b * model.mounts[i].viscoelastic.dratio_at(lam)
+    return f
+
+
+@dataclass(frozen=True, eq=False)
+class ViscoelasticFamily:
+    """The model's augmented first-order family ``E x' = A(T) x`` (a :class:`FirstOrderFamily`).
+
+    Parameters
+    ----------
+    model : Model
+        With at least one viscoelastic mount.
+    linearization : {"equilibrium", "classical"}, optional
+    fluid_frequency : float
+        Frequency (Hz) of compressible fluid coefficients.
+    """
+
+    model: Model
+    linearization: str | None = None
+    fluid_frequency: float = 0.0
+    first_order = True
+    n_dof = 6
+
+    def __post_init__(self) -> None:
+        base = ModelFamily(self.model, self.linearization, damped=True, fluid_frequency=self.fluid_frequency)
+        object.__setattr__(self, "base", base)
+        object.__setattr__(self, "linearization", base.linearization)
+        object.__setattr__(self, "terms", _terms(self.model))
+        object.__setattr__(self, "positions", np.array([mt.position for mt in self.model.mounts], dtype=float))
+
+    @property
+    def n(self) -> int:
+        return 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
+
+    @property
+    def weights(self) -> Array:
+        """Participation weights: the mass diagonal at rest."""
+        return np.diag(self.model.mass_matrix).copy()
+
+    def system(self, thrusts: Array):
+        """``M, D + G, K`` stacks and the arms at equilibrium ``rho (S, nm, 3)`` at each thrust."""
+        p = np.atleast_1d(np.asarray(thrusts, dtype=float))
+        base: ModelFamily = self.base  # type: ignore[attr-defined]
+        if base.is_affine:
+            m, d, g, k = base.matrices(p)
+            rho = np.broadcast_to(self.positions, (p.size,) + self.positions.shape)  # type: ignore[attr-defined]
+        else:
+            m, d, g, k, _, r0 = base.evaluate(p, strict=False)
+            rho = np.einsum("sab,mb->sma", r0, self.positions)  # type: ignore[attr-defined]
+        return np.asarray(m), np.asarray(d + g), np.asarray(k), rho
+
+    def matrices(self, p: Array) -> tuple[Array, Array]:
+        m, c, k, rho = self.system(p)
+        return augmented_matrices(m, c, k, rho, self.terms)  # type: ignore[attr-defined]
+
+    def affine_parts(self):
+        """``(E, A0, A1)`` when the elastic family is exactly affine with constant G, else None."""
+        parts = self.base.affine_parts()  # type: ignore[attr-defined]
+        if parts is None:
+            return None
+        m, d, g, k0, k1 = parts
+        rho = self.positions[None]  # type: ignore[attr-defined]
+        e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms)  # type: ignore[attr-defined]
+        a1 = np.zeros_like(a0[0])
+        a1[6:12, :6] = -k1
+        return e[0], a0[0], a1
+
+
+@dataclass(frozen=True)
+class ExactOnset:
+    """An onset of the Prony realisation checked on the exact law.
+
+    Attributes
+    ----------
+    thrust, omega : float
+        The onset of the augmented (Prony) system: thrust (N), frequency (rad/s).
+    exact_thrust, exact_omega : float or None
+        The root of the exact eigenproblem ``det F(i omega, T) = 0`` Newton converged to from it
+        (None when Newton did not converge).
+    thrust_difference, omega_difference : float or None
+        ``exact - Prony``, relative to the Prony values (the frequency relative to ``max(omega, 1)``).
+    iterations : int
+    """
+
+    thrust: float
+    omega: float
+    exact_thrust: float | None
+    exact_omega: float | None
+    thrust_difference: float | None
+    omega_difference: float | None
+    iterations: int
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+def exact_onset(model: Model, thrust: float, omega: float, linearization: str | None = None,
+                fluid_frequency: float = 0.0) -> ExactOnset:
+    """Newton on ``det F(i omega, T) = 0`` (the exact law) from an onset ``(thrust, omega)``.
+
+    For a flutter onset both ``T`` and ``omega`` are unknowns (``det`` is complex: two real
+    equations); for divergence (``omega = 0``, where every law has its static stiffness)
+    ``T`` alone. The steps use ``d log det F = trace(F^-1 dF)``; ``dF/dT`` by central differences
+    of the linearization (exact for an affine model).
+    """
+    fam = ViscoelasticFamily(model, linearization, fluid_frequency)
+
+    def parts(t: float):
+        m, c, k, rho = fam.system(np.array([t]))
+        return m[0], c[0], k[0], rho[0]
+
+    t, w = float(thrust), float(abs(omega))
+    flutter = w > 0.0
+    it = 0
+    converged = False
+    dt = dw = np.inf
+    for it in range(1, NEWTON_MAX + 1):
+        h = 1e-6 * max(abs(t), 1.0)
+        m, c, k, rho = parts(t)
+        lam = 1j * w
+        f = dynamic_stiffness(lam, m, c, k, rho, model)
+        if not np.isfinite(f).all():
+            break
+        kp = parts(t + h)[2]
+        km = parts(t - h)[2]
+        try:
+            finv = np.linalg.inv(f)
+        except np.linalg.LinAlgError:
+            converged = True
+            break
+        b = np.trace(finv @ ((kp - km) / (2 * h)))
+        if flutter:
+            a = np.trace(finv @ _d_dynamic_stiffness(lam, m, c, rho, model)) * 1j
+            jac = np.array([[a.real, b.real], [a.imag, b.imag]])
+            try:
+                dw, dt = np.linalg.solve(jac, np.array([-1.0, 0.0]))
+            except np.linalg.LinAlgError:
+                break
+        else:
+            dw, dt = 0.0, float(-1.0 / b.real) if b.real != 0 else np.nan
+        if not (np.isfinite(dw) and np.isfinite(dt)):
+            break
+        t, w = t + dt, w + dw
+        if abs(dt) <= NEWTON_TOL * max(abs(t), 1.0) and abs(dw) <= NEWTON_TOL * max(abs(w), 1.0):
+            converged = True
+            break
+    if not converged and np.isfinite(dt) and abs(dt) <= NEWTON_FLOOR * max(abs(t), 1.0) \
+            and abs(dw) <= NEWTON_FLOOR * max(abs(w), 1.0):
+        converged = True
+    if not converged:
+        return ExactOnset(float(thrust), float(omega), None, None, None, None, it)
+    return ExactOnset(float(thrust), float(omega), t, w, (t - thrust) / thrust if thrust else t - thrust,
+                      (w - abs(omega)) / max(abs(omega), 1.0), it)
