@@ -248,6 +248,10 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
     With compressible fluid loading each mode is computed with the added mass and radiation
     damping at its own frequency, iterated to consistency (fixed point on the frequency).
     """
+    if model.is_viscoelastic:  # internal variables: the augmented first-order system
+        from .viscoelastic import viscoelastic_modes
+
+        return viscoelastic_modes(model, thrust, linearization)
     base = modes_of_system(linearize(model, thrust, linearization))
     if not model.fluid.compressible:
         return base

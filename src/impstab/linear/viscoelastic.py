@@ -255,3 +255,35 @@ def exact_onset(model: Model, thrust: float, omega: float, linearization: str | 
         return ExactOnset(float(thrust), float(omega), None, None, None, None, it)
     return ExactOnset(float(thrust), float(omega), t, w, (t - thrust) / thrust if thrust else t - thrust,
                       (w - abs(omega)) / max(abs(omega), 1.0), it)
+
+
+def viscoelastic_modes(model: Model, thrust: float = 0.0, linearization: str | None = None):
+    """Modes of the augmented system at ``thrust`` (a :class:`~impstab.linear.modes.ModalResult`).
+
+    Every eigenvalue of ``E^-1 A`` with ``omega >= 0`` is a mode, the real relaxation roots of
+    the internal variables included (``omega = 0``, ``sigma < 0``); shapes and the decoupling
+    table are those of the displacement states ``q``. Roots whose displacement part vanishes
+    (an internal variable that no motion of the body excites) are left out.
+    """
+    from .modes import ModalResult, _canonical_repeated, energy_shares
+
+    fam = ViscoelasticFamily(model, linearization)
+    m, c, k, rho = fam.system(np.array([float(thrust)]))
+    if not np.isfinite(k).all():
+        from ..errors import NumericalError
+
+        raise NumericalError(f"no static equilibrium found at thrust {thrust:.6g} N: the mounts cannot carry this thrust")
+    e, a = augmented_matrices(m, c, k, rho, fam.terms)  # type: ignore[attr-defined]
+    vals, vecs = np.linalg.eig(np.linalg.solve(e[0], a[0]))
+    scale = max(np.abs(vals).max(), 1e-300)
+    q = vecs[:6]
+    size = np.linalg.norm(q, axis=0) / np.maximum(np.linalg.norm(vecs, axis=0), 1e-300)
+    keep = ((vals.imag > 1e-12 * scale) | (np.abs(vals.imag) <= 1e-12 * scale)) & (size > 1e-10)
+    vals, vecs = vals[keep], q[:, keep]
+    vals = np.where(np.abs(vals.imag) <= 1e-12 * scale, vals.real + 0j, vals)
+    order = np.lexsort((vals.real, np.abs(vals.imag)))
+    vals, vecs = vals[order], vecs[:, order]
+    vecs = _canonical_repeated(vals, vecs, np.diag(m[0]))
+    big = np.argmax(np.abs(vecs), axis=0)
+    shapes = vecs / vecs[big, np.arange(vecs.shape[1])]
+    return ModalResult(float(thrust), fam.linearization, vals, shapes, energy_shares(shapes, m[0]))  # type: ignore[arg-type]

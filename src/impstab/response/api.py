@@ -97,7 +97,15 @@ def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearizat
     pos = np.array([m.position for m in model.mounts], dtype=float)[None]
     km = np.array([m.stiffness for m in model.mounts], dtype=float)[None]
     cm = np.array([m.damping for m in model.mounts], dtype=float)[None]
-    sol = harmonic_response(
+    respond = harmonic_response
+    if model.is_viscoelastic:  # the exact complex stiffness k*(omega) of each mount at each frequency
+        from functools import partial
+
+        from .viscoelastic import viscoelastic_harmonic_response
+
+        respond = partial(viscoelastic_harmonic_response, model)
+        settings["mounts"] = "viscoelastic: the exact complex stiffness of each law at every frequency"
+    sol = respond(
         lin.M[None], lin.D[None], lin.G[None], lin.K[None], lin.rotation[None], pos, km, cm,
         2.0 * np.pi * f, loads[None], fluid=fluid_extra, foundation=hull,
         fluid_damping=np.zeros((1, 6, 6)),  # linearize takes the fluid at 0 Hz: no radiation damping in lin.D
