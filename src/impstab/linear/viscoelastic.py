@@ -25,6 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 from numpy.typing import NDArray
 
 from ..kinematics import rigid_map
@@ -39,6 +40,8 @@ Array = NDArray[np.float64]
 #: Newton on the exact eigenproblem stops when the step is below this (relative)
 NEWTON_TOL = 1e-12
 NEWTON_MAX = 40
+#: eigenvalues of F this close (relative to max |F|) are one cluster (identical planes)
+CLUSTER = 1e-8
 #: a last step below this (relative) after NEWTON_MAX steps is converged to rounding
 NEWTON_FLOOR = 1e-9
 
@@ -198,20 +201,38 @@ class ExactOnset:
         return dict(self.__dict__)
 
 
+def _cluster(f: Array):
+    """Right and left bases ``X, Y`` of the eigenvalues of ``f`` nearest zero (a cluster of equal
+    ones: identical planes of a symmetric layout give each root twice) and their mean."""
+    vals, left, right = scipy.linalg.eig(f, left=True, right=True)
+    scale = max(float(np.abs(f).max()), 1e-300)
+    j = int(np.argmin(np.abs(vals)))
+    members = np.flatnonzero(np.abs(vals - vals[j]) <= CLUSTER * scale)
+    return right[:, members], left[:, members], complex(vals[members].mean())
+
+
+def _mean_derivative(x: Array, y: Array, df: Array) -> complex:
+    """Derivative of the cluster's mean eigenvalue: ``trace((Y^H X)^-1 Y^H dF X) / m``."""
+    yx = y.conj().T @ x
+    return complex(np.trace(np.linalg.solve(yx, y.conj().T @ df @ x)) / x.shape[1])
+
+
 def exact_onset(model: Model, thrust: float, omega: float, linearization: str | None = None,
                 fluid_frequency: float = 0.0) -> ExactOnset:
-    """Newton on ``det F(i omega, T) = 0`` (the exact law) from an onset ``(thrust, omega)``.
+    """Newton on the exact eigenproblem ``F(i omega, T) v = 0`` (the mounts' laws, not their Prony
+    fits) from an onset ``(thrust, omega)``.
 
-    For a flutter onset both ``T`` and ``omega`` are unknowns (``det`` is complex: two real
-    equations); for divergence (``omega = 0``, where every law has its static stiffness)
-    ``T`` alone. The steps use ``d log det F = trace(F^-1 dF)``; ``dF/dT`` by central differences
-    of the linearization (exact for an affine model).
+    The unknowns are ``T`` and ``omega`` (for divergence, ``omega = 0``, where every law has its
+    static stiffness: ``T`` alone), the equation the eigenvalue ``mu(i omega, T)`` of ``F`` nearest
+    zero (the mean of a cluster of equal ones, so that the identical planes of a symmetric layout
+    keep the convergence quadratic), with its exact derivative ``y^H dF x / y^H x``;
+    ``dF/d omega = i dF/d lambda`` exactly, ``dF/dT`` by central differences of the linearization.
     """
     fam = ViscoelasticFamily(model, linearization, fluid_frequency)
 
-    def parts(t: float):
+    def dyn(t: float, lam: complex):
         m, c, k, rho = fam.system(np.array([t]))
-        return m[0], c[0], k[0], rho[0]
+        return dynamic_stiffness(lam, m[0], c[0], k[0], rho[0], model), (m[0], c[0], rho[0])
 
     t, w = float(thrust), float(abs(omega))
     flutter = w > 0.0
@@ -219,32 +240,25 @@ def exact_onset(model: Model, thrust: float, omega: float, linearization: str | 
     converged = False
     dt = dw = np.inf
     for it in range(1, NEWTON_MAX + 1):
-        h = 1e-6 * max(abs(t), 1.0)
-        m, c, k, rho = parts(t)
         lam = 1j * w
-        f = dynamic_stiffness(lam, m, c, k, rho, model)
+        f, (m, c, rho) = dyn(t, lam)
         if not np.isfinite(f).all():
             break
-        kp = parts(t + h)[2]
-        km = parts(t - h)[2]
+        h = 1e-6 * max(abs(t), 1.0)
+        f_t = (dyn(t + h, lam)[0] - dyn(t - h, lam)[0]) / (2 * h)
         try:
-            finv = np.linalg.inv(f)
-        except np.linalg.LinAlgError:
-            converged = True
+            x, y, mu = _cluster(f)
+            b = _mean_derivative(x, y, f_t)
+            if flutter:
+                a = 1j * _mean_derivative(x, y, _d_dynamic_stiffness(lam, m, c, rho, model))
+                dw, dt = np.linalg.solve(np.array([[a.real, b.real], [a.imag, b.imag]]), [-mu.real, -mu.imag])
+            else:
+                dw, dt = 0.0, -mu.real / b.real
+        except (np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
             break
-        b = np.trace(finv @ ((kp - km) / (2 * h)))
-        if flutter:
-            a = np.trace(finv @ _d_dynamic_stiffness(lam, m, c, rho, model)) * 1j
-            jac = np.array([[a.real, b.real], [a.imag, b.imag]])
-            try:
-                dw, dt = np.linalg.solve(jac, np.array([-1.0, 0.0]))
-            except np.linalg.LinAlgError:
-                break
-        else:
-            dw, dt = 0.0, float(-1.0 / b.real) if b.real != 0 else np.nan
         if not (np.isfinite(dw) and np.isfinite(dt)):
             break
-        t, w = t + dt, w + dw
+        t, w = t + float(dt), w + float(dw)
         if abs(dt) <= NEWTON_TOL * max(abs(t), 1.0) and abs(dw) <= NEWTON_TOL * max(abs(w), 1.0):
             converged = True
             break
