@@ -182,3 +182,44 @@ def test_hysteretic_table_is_fitted_over_its_band_and_said_so():
     assert any("hysteretic" in w for w in res.warnings)
     d = res.to_dict()["viscoelastic"]
     assert d["fits"][0]["hysteretic"] and d["fits"][0]["fit_error"] > 0
+
+
+def test_rotated_equilibrium_onset_is_a_root_of_the_exact_equation():
+    """Asymmetric layout (tilted axes, a 6x6 mount, off-axis thrust), equilibrium linearization (the
+    body rotates under thrust, the family is not affine): at the reported onset the exact dynamic
+    stiffness, written out here with the arms R0 r_i of the equilibrium, is singular, and the
+    rightmost characteristic root changes sign across it."""
+    from conftest import asymmetric_model_dict
+
+    d = asymmetric_model_dict()
+    tau, s = 3e-3, 1.6
+    for m in d["mounts"][:3]:
+        m["viscoelastic"] = {"law": "standard-linear-solid", "stiffening": s, "relaxation_time": tau}
+    model = model_from_dict(d)
+    res = impstab.critical_thrust(model)
+    assert res.thrust is not None and res.kind == "flutter"
+
+    def exact_f(t, lam):
+        lin = impstab.linearize(model, t)
+        f = lam * lam * lin.M + lam * (lin.D + lin.G) + lin.K + 0j
+        r = (1 + lam * s * tau) / (1 + lam * tau)
+        for mt in model.mounts[:3]:
+            arm = lin.rotation @ mt.position
+            b = np.hstack([np.eye(3), -np.array([[0, -arm[2], arm[1]], [arm[2], 0, -arm[0]], [-arm[1], arm[0], 0]])])
+            f += b.T @ mt.stiffness[:3, :3] @ b * (r - 1)
+        return f
+
+    sv = np.linalg.svd(exact_f(res.thrust, 1j * res.omega), compute_uv=False)
+    assert sv[-1] / sv[0] < 1e-10
+
+    def growth(t):
+        lin = impstab.linearize(model, t)
+        # the same F times (1 + lambda tau): a cubic matrix polynomial, rightmost root by a companion pencil
+        kv = np.zeros((6, 6))
+        for mt in model.mounts[:3]:
+            arm = lin.rotation @ mt.position
+            b = np.hstack([np.eye(3), -np.array([[0, -arm[2], arm[1]], [arm[2], 0, -arm[0]], [-arm[1], arm[0], 0]])])
+            kv += b.T @ mt.stiffness[:3, :3] @ b
+        return _poly_roots(lin, kv, s - 1, tau).real.max()
+
+    assert growth(res.thrust * (1 - 1e-6)) < 0 < growth(res.thrust * (1 + 1e-6))
