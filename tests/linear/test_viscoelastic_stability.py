@@ -223,3 +223,24 @@ def test_rotated_equilibrium_onset_is_a_root_of_the_exact_equation():
         return _poly_roots(lin, kv, s - 1, tau).real.max()
 
     assert growth(res.thrust * (1 - 1e-6)) < 0 < growth(res.thrust * (1 + 1e-6))
+
+
+def test_locus_and_modes_are_those_of_the_augmented_system():
+    model = _model(linearization="classical")
+    g, tau = 0.5, 2e-3
+    crit = impstab.critical_thrust(model)
+    thrusts = np.array([0.0, 0.5, 0.999, 1.001]) * crit.thrust
+    loc = impstab.locus(model, thrusts)
+    assert loc.eigenvalues.shape == (4, 21)
+    for i, t in enumerate(thrusts):
+        roots = _poly_roots(impstab.linearize(model, t, "classical"), model.elastic_stiffness, g, tau)
+        lam = loc.eigenvalues[i]
+        for r in roots:
+            assert np.min(np.abs(lam - r)) <= 1e-7 * max(abs(r), 1.0)
+    assert loc.eigenvalues[2].real.max() < 0 < loc.eigenvalues[3].real.max()
+    md = impstab.modes(model, thrusts[3])
+    assert md.eigenvalues.real.max() > 0
+    upper = [r for r in _poly_roots(impstab.linearize(model, thrusts[3], "classical"), model.elastic_stiffness, g, tau)
+             if r.imag > 1e-9]
+    for r in upper:
+        assert np.min(np.abs(md.eigenvalues - r)) <= 1e-7 * abs(r)
