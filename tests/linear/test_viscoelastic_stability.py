@@ -244,3 +244,24 @@ def test_locus_and_modes_are_those_of_the_augmented_system():
              if r.imag > 1e-9]
     for r in upper:
         assert np.min(np.abs(md.eigenvalues - r)) <= 1e-7 * abs(r)
+
+
+def test_reduced_family_drops_only_the_unreached_relaxation_roots():
+    """Two Prony terms on each of 3 mounts: 30 states, of which 2 x (9 - 6) internal combinations no
+    motion reaches (eigenvalues -1/tau_j, stable); the reduced family keeps every other eigenvalue
+    and gives the same critical thrust through the engine."""
+    model = _model({"law": "prony", "terms": [[0.3, 1e-3], [0.5, 2e-2]]}, linearization="classical")
+    full, small = ViscoelasticFamily(model), ViscoelasticFamily(model, reduced=True)
+    assert (full.n, small.n) == (30, 24)
+    e, a = full.matrices(np.array([8000.0]))
+    er, ar = small.matrices(np.array([8000.0]))
+    lam = list(np.linalg.eigvals(np.linalg.solve(e[0], a[0])))
+    for r in np.linalg.eigvals(np.linalg.solve(er[0], ar[0])):
+        j = int(np.argmin(np.abs(np.array(lam) - r)))
+        assert abs(lam[j] - r) <= 1e-8 * max(abs(r), 1.0)
+        lam.pop(j)
+    np.testing.assert_allclose(np.sort(np.real(lam)), [-1e3] * 3 + [-50.0] * 3, rtol=1e-8)
+    from impstab.linear.critical import critical_load_family
+
+    t_full = critical_load_family(full, 30000.0).load
+    assert impstab.critical_thrust(model).thrust == pytest.approx(t_full, rel=1e-10)

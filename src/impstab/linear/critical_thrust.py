@@ -208,7 +208,7 @@ def critical_thrust(
         und = res
     load, omega, check, fits, visco_notes = res.load, res.omega, None, (), ()
     if model.is_viscoelastic:
-        load, omega, check, fits, visco_notes = _viscoelastic_check(model, res, fam.linearization, f_fluid)
+        load, omega, check, fits, visco_notes = _viscoelastic_check(model, res, fam.linearization, f_fluid, fam)
     notes = operating_point_warnings(load, model.thrust.operating, t_max)
     return CriticalThrust(
         thrust=load,
@@ -246,11 +246,11 @@ def _family(model: Model, linearization: str | None, fluid_frequency: float = 0.
     if model.is_viscoelastic:
         from .viscoelastic import ViscoelasticFamily
 
-        return ViscoelasticFamily(model, linearization, fluid_frequency)
+        return ViscoelasticFamily(model, linearization, fluid_frequency, reduced=True)
     return ModelFamily(model, linearization, fluid_frequency=fluid_frequency)
 
 
-def _viscoelastic_check(model: Model, res: CriticalLoad, linearization: str, f_fluid: float):
+def _viscoelastic_check(model: Model, res: CriticalLoad, linearization: str, f_fluid: float, family=None):
     """``(thrust, omega, ExactOnset or None, fits, warnings)``: the onset of the Prony realisation solved
     again on the exact laws (Newton, :func:`~impstab.linear.viscoelastic.exact_onset`); the exact
     root is reported when Newton converges to the same root."""
@@ -270,7 +270,7 @@ def _viscoelastic_check(model: Model, res: CriticalLoad, linearization: str, f_f
                      "is solved again on the table itself at the onset frequency")
     if res.load is None:
         return None, res.omega, None, fits, tuple(notes)
-    check = exact_onset(model, res.load, res.omega or 0.0, linearization, f_fluid)
+    check = exact_onset(model, res.load, res.omega or 0.0, linearization, f_fluid, family)
     if check.exact_thrust is None:
         notes.append("Newton on the exact viscoelastic eigenproblem did not converge at the onset: "
                      "the value is that of the Prony realisation")

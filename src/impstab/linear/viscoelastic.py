@@ -55,13 +55,45 @@ def _terms(model: Model):
     return out
 
 
-def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms) -> tuple[Array, Array]:
+def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced: bool = False) -> tuple[Array, Array]:
     """``E, A`` of the augmented state for stacks ``m, c = D + G, k (S, 6, 6)`` and arms ``rho (S, nm, 3)``.
 
     ``terms`` as :func:`_terms` returns. Returns ``E, A (S, N, N)``, ``N = 12 + 3 sum n_i``.
+
+    ``reduced``: the internal variables that share a relaxation time ``tau`` obey one equation
+    ``tau z' = B q - z`` (``B`` the mounts' maps stacked): only ``z`` in the range of ``B`` (rank
+    at most 6) is reached from the motion, the rest decays at ``-1/tau`` whatever the body does
+    (block-triangular form). Those are dropped: the states ``w = U^T z`` (``U`` an orthonormal
+    basis of range B, from an SVD) keep every other eigenvalue exactly, and the stability; the
+    dropped roots ``-1/tau`` are stable.
     """
     s = m.shape[0]
-    nz = 3 * sum(len(g) for _, _, g, _ in terms)
+    kk = np.array(k, dtype=float, copy=True)
+    blocks = []   # (rows from q (S, r, 6), force columns (S, 6, r), tau)
+    if reduced:
+        groups: dict[float, list] = {}
+        for i, kmount, g, tau in terms:
+            for gj, tj in zip(g, tau):
+                groups.setdefault(float(tj), []).append((i, kmount, gj))
+        for tj, members in groups.items():
+            b = np.concatenate([rigid_map(rho[:, i]) for i, _, _ in members], axis=1)          # (S, 3m, 6)
+            cols = np.concatenate([gj * np.swapaxes(rigid_map(rho[:, i]), -1, -2) @ kmount[None]
+                                   for i, kmount, gj in members], axis=2)                     # (S, 6, 3m)
+            for i, kmount, gj in members:
+                bi = rigid_map(rho[:, i])
+                kk += gj * np.swapaxes(bi, -1, -2) @ kmount[None] @ bi
+            u, sv, _ = np.linalg.svd(np.where(np.isfinite(b), b, 0.0))
+            rank = int((sv[0] > 1e-12 * sv[0, :1]).sum())  # invariant under the rotation of the arms
+            u = u[:, :, :rank]
+            blocks.append((np.swapaxes(u, -1, -2) @ b, cols @ u, tj))
+    else:
+        for i, kmount, g, tau in terms:
+            b = rigid_map(rho[:, i])                       # (S, 3, 6)
+            btk = np.swapaxes(b, -1, -2) @ kmount[None]    # (S, 6, 3)
+            for gj, tj in zip(g, tau):
+                kk += gj * btk @ b
+                blocks.append((b, gj * btk, float(tj)))
+    nz = sum(blk[0].shape[1] for blk in blocks)
     n = 12 + nz
     e = np.zeros((s, n, n))
     a = np.zeros((s, n, n))
@@ -70,18 +102,13 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms) -> tuple
     e[:, 12:, 12:] = np.eye(nz)
     a[:, :6, 6:12] = np.eye(6)
     a[:, 6:12, 6:12] = -c
-    kk = np.array(k, dtype=float, copy=True)
     row = 12
-    for i, kmount, g, tau in terms:
-        b = rigid_map(rho[:, i])                       # (S, 3, 6)
-        kb = kmount[None] @ b                          # (S, 3, 6)
-        btk = np.swapaxes(b, -1, -2) @ kmount[None]    # (S, 6, 3)
-        for gj, tj in zip(g, tau):
-            kk += gj * np.swapaxes(b, -1, -2) @ kb
-            a[:, 6:12, row:row + 3] = gj * btk
-            a[:, row:row + 3, :6] = b / tj
-            a[:, row:row + 3, row:row + 3] = -np.eye(3) / tj
-            row += 3
+    for from_q, force, tj in blocks:
+        r = from_q.shape[1]
+        a[:, 6:12, row:row + r] = force
+        a[:, row:row + r, :6] = from_q / tj
+        a[:, row:row + r, row:row + r] = -np.eye(r) / tj
+        row += r
     a[:, 6:12, :6] = -kk
     return e, a
 
@@ -120,11 +147,15 @@ class ViscoelasticFamily:
     linearization : {"equilibrium", "classical"}, optional
     fluid_frequency : float
         Frequency (Hz) of compressible fluid coefficients.
+    reduced : bool
+        Drop the internal variables no motion reaches (see :func:`augmented_matrices`): the same
+        stability and every other eigenvalue, fewer states (the critical-thrust search uses it).
     """
 
     model: Model
     linearization: str | None = None
     fluid_frequency: float = 0.0
+    reduced: bool = False
     first_order = True
     n_dof = 6
 
@@ -137,7 +168,16 @@ class ViscoelasticFamily:
 
     @property
     def n(self) -> int:
-        return 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
+        hit = self.__dict__.get("_n")
+        if hit is None:
+            if self.reduced:  # the ranks do not change with the thrust (a rotation of the arms)
+                rho = self.positions[None]  # type: ignore[attr-defined]
+                eye = np.eye(6)[None]
+                hit = int(augmented_matrices(eye, eye, eye, rho, self.terms, True)[1].shape[-1])  # type: ignore[attr-defined]
+            else:
+                hit = 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
+            object.__setattr__(self, "_n", hit)
+        return hit
 
     @property
     def weights(self) -> Array:
@@ -158,7 +198,7 @@ class ViscoelasticFamily:
 
     def matrices(self, p: Array) -> tuple[Array, Array]:
         m, c, k, rho = self.system(p)
-        return augmented_matrices(m, c, k, rho, self.terms)  # type: ignore[attr-defined]
+        return augmented_matrices(m, c, k, rho, self.terms, self.reduced)  # type: ignore[attr-defined]
 
     def affine_parts(self):
         """``(E, A0, A1)`` when the elastic family is exactly affine with constant G, else None."""
@@ -167,7 +207,7 @@ class ViscoelasticFamily:
             return None
         m, d, g, k0, k1 = parts
         rho = self.positions[None]  # type: ignore[attr-defined]
-        e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms)  # type: ignore[attr-defined]
+        e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms, self.reduced)  # type: ignore[attr-defined]
         a1 = np.zeros_like(a0[0])
         a1[6:12, :6] = -k1
         return e[0], a0[0], a1
@@ -218,7 +258,7 @@ def _mean_derivative(x: Array, y: Array, df: Array) -> complex:
 
 
 def exact_onset(model: Model, thrust: float, omega: float, linearization: str | None = None,
-                fluid_frequency: float = 0.0) -> ExactOnset:
+                fluid_frequency: float = 0.0, family: "ViscoelasticFamily | None" = None) -> ExactOnset:
     """Newton on the exact eigenproblem ``F(i omega, T) v = 0`` (the mounts' laws, not their Prony
     fits) from an onset ``(thrust, omega)``.
 
@@ -227,8 +267,9 @@ def exact_onset(model: Model, thrust: float, omega: float, linearization: str | 
     zero (the mean of a cluster of equal ones, so that the identical planes of a symmetric layout
     keep the convergence quadratic), with its exact derivative ``y^H dF x / y^H x``;
     ``dF/d omega = i dF/d lambda`` exactly, ``dF/dT`` by central differences of the linearization.
+    ``family``: the model's :class:`ViscoelasticFamily` when one exists already (same settings).
     """
-    fam = ViscoelasticFamily(model, linearization, fluid_frequency)
+    fam = family if family is not None else ViscoelasticFamily(model, linearization, fluid_frequency)
 
     def dyn(t: float, lam: complex):
         m, c, k, rho = fam.system(np.array([t]))
