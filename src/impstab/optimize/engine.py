@@ -22,7 +22,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["SearchResult", "search", "polish", "Variables"]
+__all__ = ["SearchResult", "search", "polish", "joined", "Variables"]
 
 Array = NDArray[np.float64]
 #: objective and violation given to pymoo for a design whose evaluation failed
@@ -162,11 +162,11 @@ def search(evaluate: Callable[[Array], tuple[Array, Array]], variables: Variable
 
 
 def polish(evaluate: Callable[[Array], tuple[Array, Array]], variables: Variables, x0: Array, *,
-           max_evaluations: int = 200, tolerance: float = 1e-6) -> tuple[Array, Array, Array, int]:
+           max_evaluations: int = 200, tolerance: float = 1e-6) -> tuple[Array, Array, Array, SearchResult]:
     """COBYLA on objective 0 from ``x0`` with the constraints ``g <= 0``, inside the bounds.
 
-    Returns ``(x, f, g, evaluations)`` of the best feasible design met (``x0`` itself if none
-    is better).
+    Returns ``(x, f, g, evaluated)``: the best feasible design met (``x0`` itself if none is
+    better) and every design the polish evaluated (generation -1).
     """
     from scipy.optimize import minimize
 
@@ -196,4 +196,15 @@ def polish(evaluate: Callable[[Array], tuple[Array, Array]], variables: Variable
         ok = np.isfinite(f).all() and np.all(g <= 0.0)
         if ok and (not (np.isfinite(best_f).all() and np.all(best_g <= 0.0)) or f[0] < best_f[0]):
             best_u, best_f, best_g = np.frombuffer(key, dtype=float), f, g
-    return variables.to_x(best_u[None])[0], best_f, best_g, len(cache)
+    us = np.array([np.frombuffer(k, dtype=float) for k in cache])
+    done = SearchResult(variables.to_x(us), np.array([v[0] for v in cache.values()]),
+                        np.array([v[1] for v in cache.values()]).reshape(len(cache), -1),
+                        np.full(len(cache), -1), np.zeros(len(cache), dtype=bool), len(cache))
+    return variables.to_x(best_u[None])[0], best_f, best_g, done
+
+
+def joined(a: SearchResult, b: SearchResult) -> SearchResult:
+    """The designs of two searches as one (``b`` after ``a``)."""
+    return SearchResult(np.vstack([a.x, b.x]), np.vstack([a.f, b.f]), np.vstack([a.g, b.g]),
+                        np.concatenate([a.generation, b.generation]), np.concatenate([a.final, b.final]),
+                        a.evaluations + b.evaluations)

@@ -15,7 +15,7 @@ import numpy as np
 
 from .style import ONSET_COLOR, PALETTE, figure_style
 
-__all__ = ["plot_tradeoff"]
+__all__ = ["plot_tradeoff", "plot_optimization"]
 
 
 _SHORT = {
@@ -58,29 +58,63 @@ def plot_tradeoff(result, isolation: str = "peak_transmissibility", stability: s
 
     t = tradeoff_table(result, isolation, stability, required_margin=required_margin,
                        deflection_limit=deflection_limit, load_limit=load_limit)
+    computed = np.isfinite(t["stability"]) & np.isfinite(t["isolation"]) & (result.dataset["status"].values.ravel() == 0)
+    return _draw(ax, t["stability"], t["isolation"], t["censored"], t["feasible"], computed & ~t["feasible"],
+                 t["pareto"], t["chosen"], required_margin, isolation_limit, _axis_label(result, stability),
+                 _axis_label(result, isolation), title or f"{result.dataset.attrs.get('study_name', 'study')}: trade-off",
+                 "beyond a static limit")
+
+
+def plot_optimization(res, ax=None):
+    """Every design an optimisation evaluated: isolation against margin, the Pareto set, the
+    constraints and the chosen (polished) design; returns the Axes."""
+    opt = res.optimization
+    h = res.history
+    x, y = -h.f[:, 1], h.f[:, 0]
+    computed = np.isfinite(x) & np.isfinite(y)
+    feasible = h.feasible
+    pareto = np.zeros(len(x), dtype=bool)
+    from ..optimize.run import _pareto_rows
+
+    pareto[_pareto_rows(h.f, feasible)] = True
+    ds = res.pareto.dataset
+    y_label = _axis_label(res.pareto, opt.objective) if opt.objective in ds else opt.objective
+    ax = _draw(ax, x, y, np.zeros(len(x), dtype=bool), feasible, computed & ~feasible, pareto, None,
+               opt.margin_min, None, "margin = critical / operating thrust (stable to thrust_max: its bound)",
+               y_label, f"{opt.name}: {int((h.generation >= 0).sum())} designs in {opt.generations} generations, "
+               f"{int((h.generation < 0).sum())} in the polish", "violates a constraint")
+    c = res.chosen
+    with figure_style():
+        ax.plot([c["margin"]], [c["isolation"]], "*", ms=13, color=PALETTE[3], mec="k", mew=0.5,
+                label=f"chosen{' (polished)' if c['polished'] else ''}: {c['isolation']:.4g} at margin {c['margin']:.3g}")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    return ax
+
+
+def _draw(ax, x, y, censored, feasible, violating, pareto, chosen, required_margin, isolation_limit,
+          x_label, y_label, title, violating_label):
     with figure_style():
         import matplotlib.pyplot as plt
         from matplotlib.ticker import FuncFormatter
 
         if ax is None:
             _, ax = plt.subplots(figsize=(8.4, 4.4))
-        x, y = t["stability"], t["isolation"]
-        ok = t["feasible"]
-        limits = (~ok) & np.isfinite(x) & np.isfinite(y) & (result.dataset["status"].values.ravel() == 0)
-        found = ok & ~t["censored"]
-        cens = ok & t["censored"]
+        ok = feasible
+        limits = violating
+        found = ok & ~censored
+        cens = ok & censored
         ax.scatter(x[found], y[found], s=14, color=PALETTE[0], alpha=0.55, lw=0, label=f"design ({found.sum()})")
         if cens.any():
             ax.scatter(x[cens], y[cens], s=16, facecolor="none", edgecolor=PALETTE[0], lw=0.8,
                        label=f"stable to thrust_max ({cens.sum()}): margin larger")
         if limits.any():
             ax.scatter(x[limits], y[limits], s=14, marker="x", color="#9A9A9A", lw=0.8,
-                       label=f"beyond a static limit ({limits.sum()})")
-        front = np.flatnonzero(t["pareto"])
+                       label=f"{violating_label} ({limits.sum()})")
+        front = np.flatnonzero(pareto)
         front = front[np.argsort(x[front])]
         ax.plot(x[front], y[front], "-o", color=PALETTE[1], ms=4.5, lw=1.3, label=f"Pareto front ({front.size})")
         ax.set_yscale("log")
-        pos = x[ok & (x > 0)]
+        pos = x[(ok | limits) & (x > 0)]
         if pos.size and pos.max() > 8 * pos.min():  # margins over a decade or more: log axis
             ax.set_xscale("log")
             ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
@@ -93,14 +127,14 @@ def plot_tradeoff(result, isolation: str = "peak_transmissibility", stability: s
             ax.set_xlim(lo, max(hi, required_margin))
         if isolation_limit is not None:
             ax.axhline(isolation_limit, color=PALETTE[2], lw=1.2, ls=":", label=f"isolation limit {isolation_limit:g}")
-        if t["chosen"] is not None:
-            c = t["chosen"]
+        if chosen is not None:
+            c = chosen
             ax.plot([x[c]], [y[c]], "*", ms=13, color=PALETTE[3], mec="k", mew=0.5,
                     label=f"chosen: {y[c]:.3g} at margin {x[c]:.3g}")
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.yaxis.set_minor_formatter(FuncFormatter(_minor_label))
-        ax.set_xlabel(_axis_label(result, stability))
-        ax.set_ylabel(_axis_label(result, isolation))
-        ax.set_title(title or f"{result.dataset.attrs.get('study_name', 'study')}: trade-off")
+        ax.set_xlabel(x_label)
+        ax.set_ylabel(y_label)
+        ax.set_title(title)
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return ax
