@@ -77,7 +77,7 @@ def _model(beam: dict | None = None, **extra) -> dict:
                                           "inertia": [[1.4, 0.05, 0.0], [0.05, 7.5, 0.1], [0.0, 0.1, 7.0]]},
             "mounts": mounts, "thrust": {"point": [-0.1, 0.01, 0.02], "direction": [1.0, 0.01, -0.02],
                                          "operating": 3000.0},
-            "analysis": {"thrust_max": 6.0e5}}
+            "analysis": {"thrust_max": 3.0e4}}
 
 
 def _stiffness_twin(data: dict) -> dict:

@@ -78,6 +78,9 @@ def _hull_stiffness(model: Model, foundation, f: NDArray) -> tuple[NDArray | Non
 
 def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearization: str | None, foundation,
              input_name: str, source: tuple[str, ...]) -> ForcedResponse:
+    from ..linear.mount_dofs import refuse_massive_beams
+
+    refuse_massive_beams(model, "the forced response")
     lin = linearize(model, thrust, linearization)
     settings: dict = {"model": model.name, "model_source": model.source or ""}
     fluid_extra = None
