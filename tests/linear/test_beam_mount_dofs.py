@@ -215,3 +215,18 @@ def test_forced_response_refuses_a_massive_beam():
     with pytest.raises(ModelError) as info:
         frequency_response(model_from_dict(_massive(1100.0)), np.linspace(1.0, 10.0, 3))
     assert info.value.field == "mounts[0].beam.density"
+
+
+def test_cli_on_the_beam_example(capsys):
+    import json
+
+    from impstab.cli import main
+
+    example = str(Path(__file__).resolve().parents[2] / "examples" / "imp_beam_mounts.toml")
+    assert main(["critical", example, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["kind"] == "flutter" and out["modes"] == ["pitch", "yaw"]
+    for args in (["simulate", example, "--thrust", "100", "--duration", "0.1"], ["modes", example]):
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "mounts[0].beam.density" in err
