@@ -112,6 +112,9 @@ def design_inputs(model: Model, f: NDArray, thrust: float, linearization: str | 
     The single route from a model to the stacked arrays of :func:`harmonic_response`, used by
     :func:`frequency_response` (one design) and by design studies (many designs in one solve).
     """
+    from ..linear.mount_dofs import refuse_massive_beams
+
+    refuse_massive_beams(model, "the forced response")
     lin = linearize(model, thrust, linearization)
     settings: dict = {}
     fluid_extra = None
