@@ -169,6 +169,12 @@ RANGES: dict[str, Range] = {
     "dpi": Range(10.0, 1200.0, "dots per inch", "a figure resolution"),
     "displacement": Range(-1e3, 1e3, "m or rad", "an initial displacement"),
     "velocity": Range(-1e6, 1e6, "m/s or rad/s", "an initial velocity"),
+    # viscoelastic mounts (impstab.model.viscoelastic)
+    "stiffening": Range(1.0, 1e6, "", "a high-frequency to static stiffness ratio"),
+    "relaxation_time": Range(1e-9, 1e6, "s", "a relaxation time"),
+    "prony_weight": Range(0.0, 1e6, "", "a Prony weight g_j"),
+    "storage_ratio": Range(1e-3, 1e6, "", "a storage-stiffness ratio k'(f) / k0"),
+    "loss_factor": Range(0.0, 10.0, "", "a loss factor"),
 }
 
 #: a direction or mount axis shorter than this (in the units the user wrote) is "zero"

@@ -65,6 +65,9 @@ def check_cmd(model_file: str) -> None:
     t.add_row("cg from A", _vec(b.cg, "m"))
     t.add_row("principal inertia about cg", _vec(np.linalg.eigvalsh(b.inertia_cg), "kg m^2"))
     t.add_row("mounts", str(len(model.mounts)))
+    for i, m in enumerate(model.mounts):
+        if m.viscoelastic is not None:
+            t.add_row(f"mount {i} law", m.viscoelastic.describe())
     kc = np.diag(model.elastic_stiffness)
     t.add_row("K_c diagonal", ", ".join(f"{n} {_fmt(v, digits=4)}" for n, v in zip(DOF_NAMES[:3], kc[:3])) + " N/m; "
               + ", ".join(f"{n} {_fmt(v, digits=4)}" for n, v in zip(DOF_NAMES[3:], kc[3:])) + " N m/rad")
@@ -274,6 +277,8 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
         t.add_row(name, value)
     for c in res.crossings:
         t.add_row(f"crossing ({c.direction})", f"{c.load:.10g} N, {c.kind}, {fmt(c.omega / (2 * np.pi))} Hz")
+    for row in _viscoelastic_rows(res):
+        t.add_row(*row)
     if res.fluid_frequency_hz is not None:
         change = "" if res.fluid_change is None else f", last change {res.fluid_change:.2e}"
         t.add_row("fluid coefficients at", f"{_fmt(res.fluid_frequency_hz)} Hz ({res.fluid_iterations} iterations{change})")
@@ -281,6 +286,23 @@ def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linea
     con.print(t)
     for w in res.warnings:
         con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
+
+
+def _viscoelastic_rows(res) -> list[tuple[str, str]]:
+    """Rows on viscoelastic mounts: the Prony realisation and the check of the onset on the exact law."""
+    if not res.viscoelastic_fits:
+        return []
+    fits = res.viscoelastic_fits
+    worst = max(f["fit_error"] for f in fits)
+    terms = sum(f["terms"] for f in fits)
+    rows = [("viscoelastic mounts", f"{len(fits)} mounts, {terms} Prony terms ({3 * terms} internal states), "
+             f"largest fit error {worst:.2e}; undamped = static stiffness")]
+    check = res.exact_onset
+    if check is not None:
+        rows.append(("exact-law check", "Newton did not converge" if check.exact_thrust is None else
+                     f"Prony onset {check.thrust:.10g} N, exact {check.exact_thrust:.10g} N "
+                     f"(relative difference {check.thrust_difference:.2e})"))
+    return rows
 
 
 def _modes_warnings(res, crit, thrust: float) -> list[str]:

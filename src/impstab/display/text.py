@@ -60,6 +60,9 @@ def mount_text(mt) -> str:
             text += f", k3 axial {number(law.k3_axial)}, shear {number(law.k3_shear)} N/m^3"
         if law.has_snubber:
             text += f", snubber {number(law.snubber_clearance)} m, {number(law.snubber_stiffness)} N/m"
+    visco = getattr(mt, "viscoelastic", None)
+    if visco is not None:
+        text += f", viscoelastic {visco.describe()}"
     return text + ")"
 
 

@@ -142,6 +142,9 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
     -------
     SimulationResult
     """
+    from ..model.viscoelastic import refuse_viscoelastic
+
+    refuse_viscoelastic(model, "the nonlinear time histories (simulate)")
     duration = _finite("duration", duration)
     history = as_thrust_history(thrust)
     solver = get_integrator(integrator)

@@ -140,6 +140,9 @@ class NonlinearSystem:
     system: DynamicSystem = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        from ..model.viscoelastic import refuse_viscoelastic
+
+        refuse_viscoelastic(self.model, "the nonlinear time-domain model (simulate, postcritical)")
         object.__setattr__(self, "system", pack_dynamics(self.model, self.pitch_limit))
 
     @classmethod

@@ -72,6 +72,10 @@ class CriticalThrust:
     fluid_iterations: int = 0
     fluid_change: float | None = None
     warnings: tuple[str, ...] = ()
+    #: viscoelastic mounts: the onset of the Prony realisation checked on the exact laws
+    #: (:func:`impstab.linear.viscoelastic.exact_onset`), and the fits of the mounts' laws
+    exact_onset: object | None = None
+    viscoelastic_fits: tuple[dict, ...] = ()
 
     def __repr__(self) -> str:
         from ..display import critical_text
@@ -118,6 +122,11 @@ class CriticalThrust:
             "fluid_iterations": self.fluid_iterations,
             "fluid_change": self.fluid_change,
             "warnings": list(self.warnings),
+            "viscoelastic": None if not self.viscoelastic_fits else {
+                "undamped_stiffness": "static",
+                "fits": list(self.viscoelastic_fits),
+                "exact_check": None if self.exact_onset is None else self.exact_onset.to_dict(),
+            },
             "model": self.model_name,
             "impstab_version": __version__,
         }
@@ -189,7 +198,7 @@ def critical_thrust(
     t_max = check_number("thrust_max", thrust_max if thrust_max is not None else model.analysis.thrust_max, "thrust")
     search = dict(n_scan=n_scan)
     f_fluid, iterations, change = 0.0, 0, None
-    fam = ModelFamily(model, linearization)
+    fam = _family(model, linearization)
     res: CriticalLoad = critical_load_family(fam, t_max, all_crossings=all_crossings, **search)
     if model.fluid.compressible:
         # radiation damping and added mass at the onset frequency, iterated to consistency
@@ -197,7 +206,7 @@ def critical_thrust(
             if res.load is None or not res.omega:
                 break
             f_new = res.omega / (2 * np.pi)
-            fam = ModelFamily(model, linearization, fluid_frequency=f_new)
+            fam = _family(model, linearization, fluid_frequency=f_new)
             new = critical_load_family(fam, t_max, all_crossings=all_crossings, **search)
             change = None if new.load is None else abs(new.load - res.load) / new.load
             res, f_fluid = new, f_new
@@ -209,12 +218,15 @@ def critical_thrust(
         )
     else:
         und = res
-    notes = operating_point_warnings(res.load, model.thrust.operating, t_max)
+    load, omega, check, fits, visco_notes = res.load, res.omega, None, (), ()
+    if model.is_viscoelastic:
+        load, omega, check, fits, visco_notes = _viscoelastic_check(model, res, fam.linearization, f_fluid, fam)
+    notes = operating_point_warnings(load, model.thrust.operating, t_max)
     shape, part = _body_part(res.mode, res.participation)
     return CriticalThrust(
-        thrust=res.load,
+        thrust=load,
         kind=res.kind,
-        omega=res.omega,
+        omega=omega,
         modes=_modes(part),
         participation=part,
         mode_shape=shape,
@@ -229,5 +241,56 @@ def critical_thrust(
         fluid_frequency_hz=f_fluid if model.fluid.compressible else None,
         fluid_iterations=iterations,
         fluid_change=change,
-        warnings=notes + tuple(res.warnings) + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
+        warnings=notes + tuple(res.warnings) + visco_notes
+        + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
+        exact_onset=check,
+        viscoelastic_fits=fits,
     )
+
+
+# -- viscoelastic mounts: the augmented first-order family and the check on the exact law ---------
+#: a correction by the exact law larger than this (relative) is not the same root: the Prony
+#: value stays and a warning says so
+EXACT_ACCEPT = 1e-2
+
+
+def _family(model: Model, linearization: str | None, fluid_frequency: float = 0.0):
+    """The elastic family, or the augmented first-order one of a model with viscoelastic mounts."""
+    if model.is_viscoelastic:
+        from .viscoelastic import ViscoelasticFamily
+
+        return ViscoelasticFamily(model, linearization, fluid_frequency, reduced=True)
+    return ModelFamily(model, linearization, fluid_frequency=fluid_frequency)
+
+
+def _viscoelastic_check(model: Model, res: CriticalLoad, linearization: str, f_fluid: float, family=None):
+    """``(thrust, omega, ExactOnset or None, fits, warnings)``: the onset of the Prony realisation solved
+    again on the exact laws (Newton, :func:`~impstab.linear.viscoelastic.exact_onset`); the exact
+    root is reported when Newton converges to the same root."""
+    from .viscoelastic import exact_onset
+
+    fits = tuple(
+        {"mount": i, "law": m.viscoelastic.law, "terms": m.viscoelastic.n_terms,
+         "fit_error": m.viscoelastic.fit_error,
+         "fit_band_hz": None if m.viscoelastic.fit_band_hz is None else m.viscoelastic.fit_band_hz.tolist(),
+         "hysteretic": m.viscoelastic.hysteretic}
+        for i, m in enumerate(model.mounts) if m.viscoelastic is not None
+    )
+    notes: list[str] = []
+    if any(f["hysteretic"] for f in fits):
+        notes.append("a tabulated loss factor that does not vanish at its lowest frequency is non-causal "
+                     "(hysteretic): stability uses its causal Prony fit over the table band, and the onset "
+                     "is solved again on the table itself at the onset frequency")
+    if res.load is None:
+        return None, res.omega, None, fits, tuple(notes)
+    check = exact_onset(model, res.load, res.omega or 0.0, linearization, f_fluid, family)
+    if check.exact_thrust is None:
+        notes.append("Newton on the exact viscoelastic eigenproblem did not converge at the onset: "
+                     "the value is that of the Prony realisation")
+        return res.load, res.omega, check, fits, tuple(notes)
+    if abs(check.thrust_difference) > EXACT_ACCEPT:
+        notes.append(f"the exact viscoelastic law moves the onset by {check.thrust_difference:.2e} (relative), "
+                     "more than a correction: the value is that of the Prony realisation; refine the fit "
+                     "(fit_terms, fit_band_hz)")
+        return res.load, res.omega, check, fits, tuple(notes)
+    return check.exact_thrust, (check.exact_omega if res.omega else res.omega), check, fits, tuple(notes)

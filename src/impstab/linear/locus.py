@@ -46,7 +46,9 @@ class LocusResult:
     Attributes
     ----------
     thrust : (N,) thrusts (N)
-    eigenvalues : (N, 12) complex, ``lambda = sigma + i omega`` (1/s), tracked by MAC
+    eigenvalues : (N, 12) complex, ``lambda = sigma + i omega`` (1/s), tracked by MAC (with
+        viscoelastic mounts: (N, 12 + 3 x Prony terms), the relaxation roots of the internal
+        variables included)
     linearization : str
     model_name : str
     critical_thrust : float or None
@@ -259,9 +261,20 @@ def locus(
         if fluid_frequency is None and crit.fluid_frequency_hz is not None:
             fluid_frequency = crit.fluid_frequency_hz
     f_fluid = float(fluid_frequency or 0.0)
-    fam = ModelFamily(model, linearization, fluid_frequency=f_fluid)
-    m, d, g, k = fam.matrices(thrusts)
-    vals, shares, mode = _tracked_branches(np.asarray(m), np.asarray(d + g), np.asarray(k))
+    if model.is_viscoelastic:  # internal variables: the augmented first-order system
+        from .viscoelastic import ViscoelasticFamily, augmented_matrices
+
+        fam = ViscoelasticFamily(model, linearization, fluid_frequency=f_fluid)
+        m, c, k, rho = fam.system(thrusts)
+        e, a = augmented_matrices(m, c, k, rho, fam.terms)  # type: ignore[attr-defined]
+        good = np.isfinite(a).all(axis=(1, 2))
+        ops = np.full(a.shape, np.nan)
+        ops[good] = np.linalg.solve(e[good], a[good])
+        vals, shares, mode = _tracked_branches(m, c, k, operators=ops)
+    else:
+        fam = ModelFamily(model, linearization, fluid_frequency=f_fluid)
+        m, d, g, k = fam.matrices(thrusts)
+        vals, shares, mode = _tracked_branches(np.asarray(m), np.asarray(d + g), np.asarray(k))
     return LocusResult(
         thrusts, vals, fam.linearization, model.name,  # type: ignore[arg-type]
         None if crit is None else crit.thrust, model.thrust.operating, mode, shares,
@@ -299,23 +312,32 @@ def _dof_groups(m, c, k) -> list[NDArray[np.int64]]:
     return [np.flatnonzero(labels == lab) for lab in np.unique(labels)]
 
 
-def _tracked_branches(m, c, k):
-    """Eigenvalues (N, 2n), kinetic-energy shares (N, 2n, n) and the mode of each column."""
+def _tracked_branches(m, c, k, operators=None):
+    """Eigenvalues (N, 2n), kinetic-energy shares (N, 2n, n) and the mode of each column.
+
+    ``operators (N, S, S)``: the first-order operators ``E^-1 A`` of an augmented system (internal
+    variables after the ``2 n`` displacement and velocity states), solved as one group; then
+    the columns are its ``S`` eigenvalues and the shares those of the displacement states.
+    """
     big, n = m.shape[0], m.shape[-1]
-    vals = np.full((big, 2 * n), np.nan + 0j)
-    shares = np.full((big, 2 * n, n), np.nan)
-    mode = np.zeros(2 * n, dtype=np.int64)
+    size = 2 * n if operators is None else operators.shape[-1]
+    vals = np.full((big, size), np.nan + 0j)
+    shares = np.full((big, size, n), np.nan)
+    mode = np.zeros(size, dtype=np.int64)
     ok = np.all(np.isfinite(m), axis=(1, 2)) & np.all(np.isfinite(c), axis=(1, 2)) & np.all(np.isfinite(k), axis=(1, 2))
     rows = np.flatnonzero(ok)
     col = 0
     first_freq = []
     done: list[NDArray] = []
-    for dofs in _dof_groups(m, c, k):
+    groups_of_dofs = _dof_groups(m, c, k) if operators is None else [np.arange(n)]
+    for dofs in groups_of_dofs:
         nb = dofs.size
         ix = np.ix_(dofs, dofs)
+        width = 2 * nb if operators is None else size
         if rows.size:
             sub = (slice(None),) + ix
-            lam, vec = np.linalg.eig(state_matrices(m[rows][sub], c[rows][sub], k[rows][sub]))
+            ops = state_matrices(m[rows][sub], c[rows][sub], k[rows][sub]) if operators is None else operators[rows]
+            lam, vec = np.linalg.eig(ops)
             lam, vec = track_modes(lam, vec)
             for other in done:
                 perm = matching_order(other, lam)
@@ -328,23 +350,23 @@ def _tracked_branches(m, c, k):
             w = np.abs(disp) ** 2 * np.diagonal(m[rows][sub], axis1=1, axis2=2)[:, :, None]
             tot = w.sum(axis=1, keepdims=True)
             w = w / np.where(tot > 0, tot, 1.0)
-            cols = np.arange(col, col + 2 * nb)
+            cols = np.arange(col, col + width)
             vals[np.ix_(rows, cols)] = lam
-            full = np.zeros((rows.size, 2 * nb, n))
+            full = np.zeros((rows.size, width, n))
             full[:, :, dofs] = np.transpose(w, (0, 2, 1))
             shares[rows[:, None], cols[None, :], :] = full
             groups = _conjugate_groups(lam)
             for gcols in groups:
                 mode[col + gcols] = len(first_freq)
                 first_freq.append(float(np.abs(lam[0, gcols].imag).max()))
-        col += 2 * nb
+        col += width
     # number the branches by frequency at the first thrust (then by growth)
     order = np.argsort(np.asarray(first_freq), kind="stable")
     renumber = np.empty_like(order)
     renumber[order] = np.arange(order.size)
     mode = renumber[mode]
     # columns listed branch by branch, the upper member of a pair first
-    key = np.lexsort((-np.nan_to_num(vals[rows[0]].imag if rows.size else np.zeros(2 * n)), mode))
+    key = np.lexsort((-np.nan_to_num(vals[rows[0]].imag if rows.size else np.zeros(size)), mode))
     return vals[:, key], shares[:, key, :], mode[key]
 
 

@@ -251,6 +251,10 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
     from .mount_dofs import refuse_massive_beams
 
     refuse_massive_beams(model, "the modal analysis")
+    if model.is_viscoelastic:  # internal variables: the augmented first-order system
+        from .viscoelastic import viscoelastic_modes
+
+        return viscoelastic_modes(model, thrust, linearization)
     base = modes_of_system(linearize(model, thrust, linearization))
     if not model.fluid.compressible:
         return base

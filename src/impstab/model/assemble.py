@@ -185,6 +185,69 @@ def _nonlinear_law(spec, axis: np.ndarray, field: str) -> NonlinearLaw | None:
     return None if law.is_linear else law
 
 
+# -- viscoelastic mounts (impstab.model.viscoelastic) ---------------------------------------------
+_VISCO_KEYS = {
+    "standard-linear-solid": ("stiffening", "relaxation_time"),
+    "prony": ("terms",),
+    "fractional-zener": ("stiffening", "relaxation_time", "alpha"),
+    "table": ("frequency_hz", "storage_ratio", "loss_factor"),
+}
+_VISCO_ALL = ("stiffening", "relaxation_time", "alpha", "terms", "frequency_hz", "storage_ratio", "loss_factor")
+
+
+def _viscoelastic(spec, field: str):
+    """The mount's :class:`~impstab.model.viscoelastic.ViscoelasticLaw` from ``[mounts.viscoelastic]``
+    (None without one); every missing, stray or inconsistent key is a one-line ModelError."""
+    v = spec.viscoelastic
+    if v is None:
+        return None
+    from .viscoelastic import ViscoelasticLaw
+
+    f = f"{field}.viscoelastic"
+    needed = _VISCO_KEYS[v.law]
+    for key in needed:
+        if getattr(v, key) is None:
+            raise ModelError(f"{f}.{key}", None, f"is required with law = {v.law!r} (keys: {', '.join(needed)})")
+    for key in _VISCO_ALL:
+        if key not in needed and getattr(v, key) is not None:
+            raise ModelError(f"{f}.{key}", getattr(v, key), f"is not read with law = {v.law!r} (keys: {', '.join(needed)})")
+    fitted = v.law in ("fractional-zener", "table")
+    for key in ("fit_band_hz", "fit_terms"):
+        if getattr(v, key) is not None and not fitted:
+            raise ModelError(f"{f}.{key}", getattr(v, key), "is read only with law = 'fractional-zener' or 'table' (the fitted laws)")
+    if v.stiffening is not None and not v.stiffening > 1.0:
+        raise ModelError(f"{f}.stiffening", v.stiffening, "must be > 1 (k(inf) / k(0): a viscoelastic mount stiffens with frequency)")
+    if v.alpha is not None and not 0.0 < v.alpha < 1.0:
+        raise ModelError(f"{f}.alpha", v.alpha, "must be strictly between 0 and 1 (the fractional order)")
+    band = None
+    if v.fit_band_hz is not None:
+        band = v.fit_band_hz
+        if not 0.0 < band[0] < band[1]:
+            raise ModelError(f"{f}.fit_band_hz", band, "must be [low, high] with 0 < low < high (Hz)")
+    if v.law == "standard-linear-solid":
+        return ViscoelasticLaw.standard_linear_solid(v.stiffening, v.relaxation_time)
+    if v.law == "prony":
+        g = np.array([t[0] for t in v.terms], float)
+        tau = np.array([t[1] for t in v.terms], float)
+        for j, (gj, tj) in enumerate(zip(g, tau)):
+            if not (RANGES["prony_weight"].low < gj <= RANGES["prony_weight"].high):
+                raise ModelError(f"{f}.terms[{j}][0]", gj, f"must be > 0 and at most {RANGES['prony_weight'].high:g} (the weight g_j)")
+            if not (RANGES["relaxation_time"].low <= tj <= RANGES["relaxation_time"].high):
+                raise ModelError(f"{f}.terms[{j}][1]", tj, RANGES["relaxation_time"].rule())
+        return ViscoelasticLaw.prony(g, tau)
+    if v.law == "fractional-zener":
+        return ViscoelasticLaw.fractional_zener(v.stiffening, v.relaxation_time, v.alpha, band, v.fit_terms)
+    freq, store, loss = (np.asarray(getattr(v, k), float) for k in ("frequency_hz", "storage_ratio", "loss_factor"))
+    if freq.size < 2:
+        raise ModelError(f"{f}.frequency_hz", v.frequency_hz, "must hold at least two frequencies")
+    if freq[0] <= 0.0 or np.any(np.diff(freq) <= 0.0):
+        raise ModelError(f"{f}.frequency_hz", v.frequency_hz, "must be > 0 and strictly increasing")
+    for key, arr in (("storage_ratio", store), ("loss_factor", loss)):
+        if arr.size != freq.size:
+            raise ModelError(f"{f}.{key}", f"{arr.size} values", f"must have one value per frequency ({freq.size})")
+    return ViscoelasticLaw.table(freq, store, loss, band, v.fit_terms)
+
+
 # -- beam mounts ([mounts.beam]) ----------------------------------------------------------------
 def _beam(m, f: str) -> BeamMount:
     """The beam of a mount table; its keys exclude the spring keys and the nonlinear law."""
@@ -219,6 +282,9 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             for key in ("k_axial", "k_shear"):
                 if getattr(m, key) is not None:
                     raise ModelError(f"{f}.{key}", getattr(m, key), "give either 'stiffness' (6x6) or k_axial/k_shear, not both")
+            if m.viscoelastic is not None:
+                raise ModelError(f"{f}.viscoelastic", m.viscoelastic.law,
+                                 "is read only with k_axial/k_shear (an axial-shear mount), not with a full 6x6 'stiffness'")
             for key in _LAW_KEYS:
                 if getattr(m, key) != 0.0:
                     raise ModelError(f"{f}.{key}", getattr(m, key),
@@ -243,15 +309,16 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             c6 = np.zeros((6, 6))
             c6[:3, :3] = axial_shear_matrix(axis, m.c_axial, m.c_shear)
         mounts.append(Mount(pos, k6, c6, unit_vector(m.axis, f"{f}.axis"), m.rated_force, m.max_deflection,
-                            nonlinear=law, beam=beam))
+                            nonlinear=law, viscoelastic=_viscoelastic(m, f), beam=beam))
     for i, ring in enumerate(doc.mount_rings):
         f = f"mount_rings[{i}]"
         axis = unit_vector(ring.axis, f"{f}.axis")
         law = _nonlinear_law(ring, axis, f)
+        visco = _viscoelastic(ring, f)
         for pos in ring_positions(ring.count, ring.radius, ring.x, ring.start_angle):
             mount = Mount.axial_shear(pos, axis, ring.k_axial, ring.k_shear, ring.c_axial, ring.c_shear)
             mounts.append(replace(mount, rated_force=ring.rated_force, max_deflection=ring.max_deflection,
-                                  nonlinear=law))
+                                  nonlinear=law, viscoelastic=visco))
     if not mounts:
         raise ModelError("mounts", [], "the model needs at least one mount or mount ring")
     if len(mounts) > MAX_MOUNTS:

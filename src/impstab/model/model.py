@@ -98,9 +98,16 @@ class Model:
 
     @property
     def is_damped(self) -> bool:
-        return any(np.any(m.damping != 0) for m in self.mounts)
+        """True when a mount has a damper or a viscoelastic law (which dissipates too)."""
+        return any(np.any(m.damping != 0) for m in self.mounts) or self.is_viscoelastic
+
+    @property
+    def is_viscoelastic(self) -> bool:
+        """True when a mount carries a viscoelastic law (internal variables in the linear analyses)."""
+        return any(m.viscoelastic is not None for m in self.mounts)
 
     def undamped(self) -> "Model":
-        """The same model with every mount damper removed."""
-        mounts = tuple(replace(m, damping=np.zeros((6, 6))) for m in self.mounts)
+        """The same model with every mount damper removed and every viscoelastic mount elastic at
+        its static stiffness."""
+        mounts = tuple(replace(m, damping=np.zeros((6, 6)), viscoelastic=None) for m in self.mounts)
         return replace(self, mounts=mounts)

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..kinematics import rigid_map6
+from .viscoelastic import ViscoelasticLaw
 from .beam import BeamMount
 
 __all__ = ["Mount", "NonlinearLaw", "axial_shear_matrix", "ring_positions", "condense", "elastic_stiffness", "mount_damping"]
@@ -129,6 +130,10 @@ class Mount:
     nonlinear : NonlinearLaw or None
         Cubic springs and snubber acting on the translation deflection, in addition to
         ``stiffness``; None (or a linear law): the mount is linear.
+    viscoelastic : ViscoelasticLaw or None
+        Frequency-dependent law scaling the translation block of ``stiffness`` (the static
+        value): ``k*(omega) = k r(omega)``, realised by internal variables
+        (:mod:`impstab.model.viscoelastic`); None: elastic.
     beam : BeamMount or None
         The Timoshenko beam the mount is (:mod:`impstab.model.beam`), along ``axis``; then
         ``stiffness`` is its clamped-free tip stiffness ``K_tip``, and a beam with mass brings
@@ -142,6 +147,8 @@ class Mount:
     rated_force: float | None = None
     max_deflection: float | None = None
     nonlinear: NonlinearLaw | None = None
+    # -- viscoelastic mounts (impstab.model.viscoelastic) --
+    viscoelastic: "ViscoelasticLaw | None" = None
     beam: BeamMount | None = None
 
     def __repr__(self) -> str:
@@ -199,6 +206,11 @@ class Mount:
     def is_nonlinear(self) -> bool:
         """True when the mount carries a nonlinear law (cubic springs or a snubber)."""
         return self.nonlinear is not None and not self.nonlinear.is_linear
+
+    @property
+    def is_viscoelastic(self) -> bool:
+        """True when the mount carries a frequency-dependent (viscoelastic) law."""
+        return self.viscoelastic is not None
 
     @property
     def has_rotational_stiffness(self) -> bool:

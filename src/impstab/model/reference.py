@@ -80,6 +80,33 @@ MODEL_REFERENCE: dict[str, E] = {
                                     "clearance; 0 means none, > 0 needs snubber_stiffness.", "snubber clearance"),
     "mounts[].snubber_stiffness": E("N/m", "Stiffness of the motion limiter beyond its clearance; required > 0 with "
                                     "snubber_clearance, and only with it.", "snubber stiffness"),
+    # viscoelastic mounts (impstab.model.viscoelastic; docs/mounts.md)
+    "mounts[].viscoelastic": E("", "Frequency-dependent law: k_axial and k_shear stay the static values and are scaled by "
+                          "the complex ratio k*(omega)/k0 of the law; stability and modes use internal variables (one "
+                          "3-vector per Prony term), the forced response the exact k*(omega). Axial-shear mounts only."),
+    "mounts[].viscoelastic.law": E("", "\"standard-linear-solid\" (k0 (1 + i w s tau)/(1 + i w tau)); \"prony\" "
+                              "(1 + sum g_j i w tau_j/(1 + i w tau_j)); \"fractional-zener\" "
+                              "((1 + s (i w tau)^alpha)/(1 + (i w tau)^alpha)); \"table\" (s(f)(1 + i eta(f)))."),
+    "mounts[].viscoelastic.stiffening": E("1", "k(inf)/k(0) = s > 1 (standard-linear-solid, fractional-zener).",
+                                     "stiffening k(inf)/k(0)"),
+    "mounts[].viscoelastic.relaxation_time": E("s", "Relaxation time tau (standard-linear-solid, fractional-zener).",
+                                          "relaxation time"),
+    "mounts[].viscoelastic.alpha": E("1", "Fractional order, strictly between 0 and 1 (fractional-zener).",
+                                "fractional order alpha"),
+    "mounts[].viscoelastic.terms": E("1, s", "Prony series [[g_1, tau_1], ...]: weights g_j > 0, relaxation times "
+                                "tau_j (s) (prony).", "Prony terms"),
+    "mounts[].viscoelastic.frequency_hz": E("Hz", "Frequencies of a measured table (ISO 10846), > 0 and strictly "
+                                       "increasing (table).", "table frequency"),
+    "mounts[].viscoelastic.storage_ratio": E("1", "Storage stiffness over the static stiffness, k'(f)/k0, one per "
+                                        "frequency (table).", "storage ratio"),
+    "mounts[].viscoelastic.loss_factor": E("1", "Loss factor eta(f) = k''/k', one per frequency (table); a value "
+                                      "that does not vanish at the lowest frequency is hysteretic (non-causal).",
+                                      "loss factor"),
+    "mounts[].viscoelastic.fit_band_hz": E("Hz", "Band [low, high] of the Prony fit of a fractional-zener or table "
+                                      "law; default: two decades either side of 1/(2 pi tau), or the table's band.",
+                                      "fit band"),
+    "mounts[].viscoelastic.fit_terms": E("", "Number of log-spaced relaxation times of the Prony fit (1 ... 30); "
+                                    "default 1.5 per decade of the band plus 1, at most 12.", "fit terms"),
     # [mounts.beam] (impstab.model.beam, docs/mounts.md)
     "mounts[].beam": E("", "A Timoshenko beam along the mount axis, instead of k_axial/k_shear or stiffness: hull end "
                        "clamped at position - length * axis, body end at position. Massless, it is exactly the 6 x 6 "
@@ -120,6 +147,33 @@ MODEL_REFERENCE: dict[str, E] = {
                                          "snubber clearance"),
     "mount_rings[].snubber_stiffness": E("N/m", "Motion limiter stiffness of each mount; required > 0 with a "
                                          "clearance.", "snubber stiffness"),
+    # viscoelastic mounts (impstab.model.viscoelastic; docs/mounts.md)
+    "mount_rings[].viscoelastic": E("", "Frequency-dependent law of each mount: k_axial and k_shear stay the static values and are scaled by "
+                          "the complex ratio k*(omega)/k0 of the law; stability and modes use internal variables (one "
+                          "3-vector per Prony term), the forced response the exact k*(omega). Axial-shear mounts only."),
+    "mount_rings[].viscoelastic.law": E("", "\"standard-linear-solid\" (k0 (1 + i w s tau)/(1 + i w tau)); \"prony\" "
+                              "(1 + sum g_j i w tau_j/(1 + i w tau_j)); \"fractional-zener\" "
+                              "((1 + s (i w tau)^alpha)/(1 + (i w tau)^alpha)); \"table\" (s(f)(1 + i eta(f)))."),
+    "mount_rings[].viscoelastic.stiffening": E("1", "k(inf)/k(0) = s > 1 (standard-linear-solid, fractional-zener).",
+                                     "stiffening k(inf)/k(0)"),
+    "mount_rings[].viscoelastic.relaxation_time": E("s", "Relaxation time tau (standard-linear-solid, fractional-zener).",
+                                          "relaxation time"),
+    "mount_rings[].viscoelastic.alpha": E("1", "Fractional order, strictly between 0 and 1 (fractional-zener).",
+                                "fractional order alpha"),
+    "mount_rings[].viscoelastic.terms": E("1, s", "Prony series [[g_1, tau_1], ...]: weights g_j > 0, relaxation times "
+                                "tau_j (s) (prony).", "Prony terms"),
+    "mount_rings[].viscoelastic.frequency_hz": E("Hz", "Frequencies of a measured table (ISO 10846), > 0 and strictly "
+                                       "increasing (table).", "table frequency"),
+    "mount_rings[].viscoelastic.storage_ratio": E("1", "Storage stiffness over the static stiffness, k'(f)/k0, one per "
+                                        "frequency (table).", "storage ratio"),
+    "mount_rings[].viscoelastic.loss_factor": E("1", "Loss factor eta(f) = k''/k', one per frequency (table); a value "
+                                      "that does not vanish at the lowest frequency is hysteretic (non-causal).",
+                                      "loss factor"),
+    "mount_rings[].viscoelastic.fit_band_hz": E("Hz", "Band [low, high] of the Prony fit of a fractional-zener or table "
+                                      "law; default: two decades either side of 1/(2 pi tau), or the table's band.",
+                                      "fit band"),
+    "mount_rings[].viscoelastic.fit_terms": E("", "Number of log-spaced relaxation times of the Prony fit (1 ... 30); "
+                                    "default 1.5 per decade of the band plus 1, at most 12.", "fit terms"),
     # [thrust]
     "thrust": E("", "The thrust: a force of magnitude T (the load parameter) along the propulsor's own axis."),
     "thrust.point": E("m", "Point of application, body frame, from A.", "thrust point"),

@@ -229,6 +229,26 @@ class FluidSpec(_Strict):
     added_mass: Optional[AddedMass6] = None
 
 
+# -- viscoelastic mounts (impstab.model.viscoelastic) -------------------------------------------
+Frequencies = Annotated[list[number("frequency")], Field(min_length=1, max_length=10000)]
+PronyTerm = Annotated[list[Finite], Field(min_length=2, max_length=2)]
+
+
+class ViscoelasticSpec(_Strict):
+    """``[mounts.viscoelastic]``: a frequency-dependent law on the static k_axial / k_shear."""
+
+    law: Literal["standard-linear-solid", "prony", "fractional-zener", "table"]
+    stiffening: Optional[number("stiffening")] = None            # k(inf) / k(0) > 1
+    relaxation_time: Optional[number("relaxation_time")] = None  # s
+    alpha: Optional[number("fraction")] = None                   # 0 < alpha < 1
+    terms: Optional[Annotated[list[PronyTerm], Field(min_length=1, max_length=100)]] = None  # [[g_j, tau_j], ...]
+    frequency_hz: Optional[Frequencies] = None                   # Hz, strictly increasing (table)
+    storage_ratio: Optional[Annotated[list[number("storage_ratio")], Field(min_length=1, max_length=10000)]] = None
+    loss_factor: Optional[Annotated[list[number("loss_factor")], Field(min_length=1, max_length=10000)]] = None
+    fit_band_hz: Optional[Annotated[list[number("frequency")], Field(min_length=2, max_length=2)]] = None
+    fit_terms: Optional[integer(1, 30, "Prony terms of the fit")] = None  # type: ignore[valid-type]
+
+
 # -- beam mounts ([mounts.beam], impstab.model.beam) -------------------------------------------
 class BeamSpec(_Strict):
     """A Timoshenko beam along the mount axis, hull end clamped, body end at the mount position."""
@@ -259,6 +279,8 @@ class MountSpec(_Strict):
     k3_shear: number("cubic_stiffness") = 0.0
     snubber_clearance: number("clearance") = 0.0
     snubber_stiffness: number("stiffness") = 0.0
+    # frequency-dependent mount law (impstab.model.viscoelastic)
+    viscoelastic: Optional[ViscoelasticSpec] = None
     beam: Optional[BeamSpec] = None             # a Timoshenko beam instead of k_axial/k_shear/stiffness
 
 
@@ -279,6 +301,8 @@ class MountRingSpec(_Strict):
     k3_shear: number("cubic_stiffness") = 0.0
     snubber_clearance: number("clearance") = 0.0
     snubber_stiffness: number("stiffness") = 0.0
+    # frequency-dependent mount law (impstab.model.viscoelastic)
+    viscoelastic: Optional[ViscoelasticSpec] = None
 
 
 class ThrustSpec(_Strict):

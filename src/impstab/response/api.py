@@ -94,6 +94,9 @@ class DesignInputs:
         Hull dynamic stiffness at each attachment (None: rigid).
     settings : dict
         ``fluid`` and ``foundation`` in words.
+    viscoelastic : Model or None
+        The model, when its mounts follow viscoelastic laws: their exact complex stiffness is then
+        applied at each frequency (such a design is solved on its own).
     """
 
     linear: LinearSystem
@@ -103,6 +106,7 @@ class DesignInputs:
     fluid: NDArray | None
     hull: NDArray | None
     settings: dict
+    viscoelastic: Model | None = None
 
 
 def design_inputs(model: Model, f: NDArray, thrust: float, linearization: str | None = None,
@@ -130,12 +134,17 @@ def design_inputs(model: Model, f: NDArray, thrust: float, linearization: str | 
         settings["fluid"] = model.fluid.model if model.fluid.model == "none" else f"{model.fluid.model} (frequency independent)"
     hull, hull_text = _hull_stiffness(model, foundation, f)
     settings["foundation"] = hull_text
+    viscoelastic = None
+    if model.is_viscoelastic:  # the exact complex stiffness k*(omega) of each mount at each frequency
+        viscoelastic = model
+        settings["mounts"] = "viscoelastic: the exact complex stiffness of each law at every frequency"
     return DesignInputs(
         linear=lin,
         positions=np.array([m.position for m in model.mounts], dtype=float).reshape(-1, 3),
         mount_stiffness=np.array([m.stiffness for m in model.mounts], dtype=float).reshape(-1, 6, 6),
         mount_damping=np.array([m.damping for m in model.mounts], dtype=float).reshape(-1, 6, 6),
         fluid=fluid_extra, hull=None if hull is None else hull[0], settings=settings,
+        viscoelastic=viscoelastic,
     )
 
 
@@ -154,7 +163,16 @@ def solve_designs(designs: Sequence[DesignInputs], f: NDArray, loads: NDArray):
     hull = None
     if any(d.hull is not None for d in designs):
         hull = np.stack([np.full((f.size, nm), np.inf, complex) if d.hull is None else d.hull for d in designs])
-    return harmonic_response(
+    respond = harmonic_response
+    if designs[0].viscoelastic is not None:
+        if len(designs) != 1:
+            raise ValueError("a design with viscoelastic mounts is solved on its own")
+        from functools import partial
+
+        from .viscoelastic import viscoelastic_harmonic_response
+
+        respond = partial(viscoelastic_harmonic_response, designs[0].viscoelastic)
+    return respond(
         lin("M"), lin("D"), lin("G"), lin("K"), lin("rotation"), stack("positions"), stack("mount_stiffness"),
         stack("mount_damping"), 2.0 * np.pi * f, loads, fluid=fluid, foundation=hull,
         fluid_damping=np.zeros((len(designs), 6, 6)),  # linearize takes the fluid at 0 Hz: no radiation damping in D

@@ -170,7 +170,7 @@ def isolation_outputs(models: list, settings: IsolationSettings | None, names: t
     if "peak_frequency_hz" in names and "peak_transmissibility" not in where:
         raise ModelError("isolation.range_hz", None, "is required for the output 'peak_frequency_hz'")
     static_names = [n for n in names if n in ("static_deflection", "peak_mount_load")]
-    groups: dict[int, list[tuple[int, object, NDArray]]] = {}
+    groups: dict[tuple, list[tuple[int, object, NDArray]]] = {}
     for j, model in enumerate(models):
         if model is None:
             continue
@@ -187,7 +187,8 @@ def isolation_outputs(models: list, settings: IsolationSettings | None, names: t
                 if dof not in DOF_NAMES:
                     raise ModelError("isolation.input", dof, f"must be one of {list(DOF_NAMES)}")
                 inputs = design_inputs(model, f, t)
-                groups.setdefault(inputs.positions.shape[0], []).append((j, inputs, unit_load(dof)))
+                key = (inputs.positions.shape[0], None if inputs.viscoelastic is None else j)  # viscoelastic: alone
+                groups.setdefault(key, []).append((j, inputs, unit_load(dof)))
         except (ModelError, NumericalError, np.linalg.LinAlgError) as exc:
             for n in names:
                 values[n][j] = np.nan

@@ -75,7 +75,8 @@ def critical_thrust_batch(
     -------
     BatchCriticalThrust
         A design with compressible fluid loading goes through :func:`impstab.critical_thrust`
-        itself (its coefficients follow the onset frequency). A value located only to the
+        itself (its coefficients follow the onset frequency), and so does one with viscoelastic
+        mounts (the augmented first-order system, and its onset checked on the exact laws). A value located only to the
         classification tolerance has status ``"ok"`` and the warning as its message.
     """
     n = len(models)
@@ -119,7 +120,8 @@ def critical_thrust_batch(
         out["t_max"][i] = t_max = float(model.analysis.thrust_max)
         out["operating"][i] = np.nan if model.thrust.operating is None else float(model.thrust.operating)
         try:
-            if model.fluid.compressible:
+            if model.fluid.compressible or model.is_viscoelastic:
+                # frequency iteration / the augmented system and its check on the exact law
                 done[i] = _single(model)
                 continue
             built = [(second_order_problem(ModelFamily(model, None, damped=True), t_max, n_scan=n_scan), True)]

@@ -1,0 +1,344 @@
+"""Linear analyses of a model with viscoelastic mounts: the augmented first-order system.
+
+Each Prony term j of mount i adds an internal 3-vector ``z_ij`` (hull frame, m). Linearized at
+the static equilibrium (where ``z_ij = d_i``, so the static stiffness carries the load), with
+``B_i = [I, -S(rho_i)]`` (3 x 6, ``rho_i = R0 r_i`` the arm at equilibrium) and ``k_i`` the
+mount's static 3 x 3 translation stiffness:
+
+    M q'' + (D + G) q' + (K + sum_ij g_ij B_i^T k_i B_i) q - sum_ij g_ij B_i^T k_i z_ij = 0
+    tau_ij z_ij' = B_i q - z_ij
+
+(K, D, G, M the elastic model's tangent matrices at that equilibrium). As ``E x' = A(T) x`` with
+``x = (q, q', z)``: ``E = diag(I, M, I)`` and 12 + 3 x (terms) x (mounts) states. Eliminating
+``z = B q / (1 + lambda tau)`` gives the exact nonlinear eigenproblem
+
+    det(lambda^2 M + lambda (D + G) + K + sum_i B_i^T k_i B_i (r_i(lambda) - 1)) = 0
+
+with the mount's ratio ``r_i = k*/k0`` (:mod:`impstab.model.viscoelastic`). The engine
+(:mod:`impstab.linear.engine`) solves the augmented family; :func:`exact_onset` then solves the
+nonlinear eigenproblem with the law itself (not its Prony fit) at the onset by Newton on
+``(T, omega)`` with ``lambda = i omega``, which checks (and for a fitted law, corrects) it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from ..kinematics import rigid_map
+from ..model.model import Model
+from ..model.viscoelastic import prony_ratio
+from .linearize import ModelFamily
+
+__all__ = ["ViscoelasticFamily", "ExactOnset", "exact_onset", "augmented_matrices", "dynamic_stiffness"]
+
+Array = NDArray[np.float64]
+
+#: Newton on the exact eigenproblem stops when the step is below this (relative)
+NEWTON_TOL = 1e-12
+NEWTON_MAX = 40
+#: eigenvalues of F this close (relative to max |F|) are one cluster (identical planes)
+CLUSTER = 1e-8
+#: a last step below this (relative) after NEWTON_MAX steps is converged to rounding
+NEWTON_FLOOR = 1e-9
+
+
+def _terms(model: Model):
+    """``(mount index, static 3x3 k, g (n,), tau (n,))`` of every viscoelastic mount."""
+    out = []
+    for i, m in enumerate(model.mounts):
+        if m.viscoelastic is not None:
+            out.append((i, np.array(m.stiffness[:3, :3]), m.viscoelastic.weights, m.viscoelastic.relaxation_times))
+    return out
+
+
+def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced: bool = False) -> tuple[Array, Array]:
+    """``E, A`` of the augmented state for stacks ``m, c = D + G, k (S, 6, 6)`` and arms ``rho (S, nm, 3)``.
+
+    ``terms`` as :func:`_terms` returns. Returns ``E, A (S, N, N)``, ``N = 12 + 3 sum n_i``.
+
+    ``reduced``: the internal variables that share a relaxation time ``tau`` obey one equation
+    ``tau z' = B q - z`` (``B`` the mounts' maps stacked): only ``z`` in the range of ``B`` (rank
+    at most 6) is reached from the motion, the rest decays at ``-1/tau`` whatever the body does
+    (block-triangular form). Those are dropped: the states ``w = U^T z`` (``U`` an orthonormal
+    basis of range B, from an SVD) keep every other eigenvalue exactly, and the stability; the
+    dropped roots ``-1/tau`` are stable.
+    """
+    s = m.shape[0]
+    kk = np.array(k, dtype=float, copy=True)
+    blocks = []   # (rows from q (S, r, 6), force columns (S, 6, r), tau)
+    if reduced:
+        groups: dict[float, list] = {}
+        for i, kmount, g, tau in terms:
+            for gj, tj in zip(g, tau):
+                groups.setdefault(float(tj), []).append((i, kmount, gj))
+        for tj, members in groups.items():
+            b = np.concatenate([rigid_map(rho[:, i]) for i, _, _ in members], axis=1)          # (S, 3m, 6)
+            cols = np.concatenate([gj * np.swapaxes(rigid_map(rho[:, i]), -1, -2) @ kmount[None]
+                                   for i, kmount, gj in members], axis=2)                     # (S, 6, 3m)
+            for i, kmount, gj in members:
+                bi = rigid_map(rho[:, i])
+                kk += gj * np.swapaxes(bi, -1, -2) @ kmount[None] @ bi
+            u, sv, _ = np.linalg.svd(np.where(np.isfinite(b), b, 0.0))
+            rank = int((sv[0] > 1e-12 * sv[0, :1]).sum())  # invariant under the rotation of the arms
+            u = u[:, :, :rank]
+            blocks.append((np.swapaxes(u, -1, -2) @ b, cols @ u, tj))
+    else:
+        for i, kmount, g, tau in terms:
+            b = rigid_map(rho[:, i])                       # (S, 3, 6)
+            btk = np.swapaxes(b, -1, -2) @ kmount[None]    # (S, 6, 3)
+            for gj, tj in zip(g, tau):
+                kk += gj * btk @ b
+                blocks.append((b, gj * btk, float(tj)))
+    nz = sum(blk[0].shape[1] for blk in blocks)
+    n = 12 + nz
+    e = np.zeros((s, n, n))
+    a = np.zeros((s, n, n))
+    e[:, :6, :6] = np.eye(6)
+    e[:, 6:12, 6:12] = m
+    e[:, 12:, 12:] = np.eye(nz)
+    a[:, :6, 6:12] = np.eye(6)
+    a[:, 6:12, 6:12] = -c
+    row = 12
+    for from_q, force, tj in blocks:
+        r = from_q.shape[1]
+        a[:, 6:12, row:row + r] = force
+        a[:, row:row + r, :6] = from_q / tj
+        a[:, row:row + r, row:row + r] = -np.eye(r) / tj
+        row += r
+    a[:, 6:12, :6] = -kk
+    return e, a
+
+
+def dynamic_stiffness(lam: complex, m, c, k, rho, model: Model, exact: bool = True) -> Array:
+    """``lambda^2 M + lambda (D + G) + K + sum_i B_i^T k_i B_i (r_i(lambda) - 1)`` (6 x 6, complex).
+
+    ``exact`` uses each mount's law; otherwise its Prony series.
+    """
+    f = lam * lam * m + lam * c + k + 0j
+    for i, kmount, g, tau in _terms(model):
+        law = model.mounts[i].viscoelastic
+        b = rigid_map(rho[i])
+        r = law.ratio_at(lam) if exact else prony_ratio(lam, g, tau)
+        f = f + b.T @ kmount @ b * (complex(r) - 1.0)
+    return f
+
+
+def _d_dynamic_stiffness(lam: complex, m, c, rho, model: Model) -> Array:
+    """``dF / d lambda`` with the exact laws."""
+    f = 2.0 * lam * m + c + 0j
+    for i, kmount, _, _ in _terms(model):
+        b = rigid_map(rho[i])
+        f = f + b.T @ kmount @ b * model.mounts[i].viscoelastic.dratio_at(lam)
+    return f
+
+
+@dataclass(frozen=True, eq=False)
+class ViscoelasticFamily:
+    """The model's augmented first-order family ``E x' = A(T) x`` (a :class:`FirstOrderFamily`).
+
+    Parameters
+    ----------
+    model : Model
+        With at least one viscoelastic mount.
+    linearization : {"equilibrium", "classical"}, optional
+    fluid_frequency : float
+        Frequency (Hz) of compressible fluid coefficients.
+    reduced : bool
+        Drop the internal variables no motion reaches (see :func:`augmented_matrices`): the same
+        stability and every other eigenvalue, fewer states (the critical-thrust search uses it).
+    """
+
+    model: Model
+    linearization: str | None = None
+    fluid_frequency: float = 0.0
+    reduced: bool = False
+    first_order = True
+    n_dof = 6
+
+    def __post_init__(self) -> None:
+        base = ModelFamily(self.model, self.linearization, damped=True, fluid_frequency=self.fluid_frequency)
+        object.__setattr__(self, "base", base)
+        object.__setattr__(self, "linearization", base.linearization)
+        object.__setattr__(self, "terms", _terms(self.model))
+        object.__setattr__(self, "positions", np.array([mt.position for mt in self.model.mounts], dtype=float))
+
+    @property
+    def n(self) -> int:
+        hit = self.__dict__.get("_n")
+        if hit is None:
+            if self.reduced:  # the ranks do not change with the thrust (a rotation of the arms)
+                rho = self.positions[None]  # type: ignore[attr-defined]
+                eye = np.eye(6)[None]
+                hit = int(augmented_matrices(eye, eye, eye, rho, self.terms, True)[1].shape[-1])  # type: ignore[attr-defined]
+            else:
+                hit = 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
+            object.__setattr__(self, "_n", hit)
+        return hit
+
+    @property
+    def weights(self) -> Array:
+        """Participation weights: the mass diagonal at rest."""
+        return np.diag(self.model.mass_matrix).copy()
+
+    def system(self, thrusts: Array):
+        """``M, D + G, K`` stacks and the arms at equilibrium ``rho (S, nm, 3)`` at each thrust."""
+        p = np.atleast_1d(np.asarray(thrusts, dtype=float))
+        base: ModelFamily = self.base  # type: ignore[attr-defined]
+        if base.is_affine:
+            m, d, g, k = base.matrices(p)
+            rho = np.broadcast_to(self.positions, (p.size,) + self.positions.shape)  # type: ignore[attr-defined]
+        else:
+            m, d, g, k, _, r0 = base.evaluate(p, strict=False)
+            rho = np.einsum("sab,mb->sma", r0, self.positions)  # type: ignore[attr-defined]
+        return np.asarray(m), np.asarray(d + g), np.asarray(k), rho
+
+    def matrices(self, p: Array) -> tuple[Array, Array]:
+        m, c, k, rho = self.system(p)
+        return augmented_matrices(m, c, k, rho, self.terms, self.reduced)  # type: ignore[attr-defined]
+
+    def affine_parts(self):
+        """``(E, A0, A1)`` when the elastic family is exactly affine with constant G, else None."""
+        parts = self.base.affine_parts()  # type: ignore[attr-defined]
+        if parts is None:
+            return None
+        m, d, g, k0, k1 = parts
+        rho = self.positions[None]  # type: ignore[attr-defined]
+        e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms, self.reduced)  # type: ignore[attr-defined]
+        a1 = np.zeros_like(a0[0])
+        a1[6:12, :6] = -k1
+        return e[0], a0[0], a1
+
+
+@dataclass(frozen=True)
+class ExactOnset:
+    """An onset of the Prony realisation checked on the exact law.
+
+    Attributes
+    ----------
+    thrust, omega : float
+        The onset of the augmented (Prony) system: thrust (N), frequency (rad/s).
+    exact_thrust, exact_omega : float or None
+        The root of the exact eigenproblem ``det F(i omega, T) = 0`` Newton converged to from it
+        (None when Newton did not converge).
+    thrust_difference, omega_difference : float or None
+        ``exact - Prony``, relative to the Prony values (the frequency relative to ``max(omega, 1)``).
+    iterations : int
+    """
+
+    thrust: float
+    omega: float
+    exact_thrust: float | None
+    exact_omega: float | None
+    thrust_difference: float | None
+    omega_difference: float | None
+    iterations: int
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+def _cluster(f: Array):
+    """Right and left bases ``X, Y`` of the eigenvalues of ``f`` nearest zero (a cluster of equal
+    ones: identical planes of a symmetric layout give each root twice) and their mean."""
+    vals, left, right = scipy.linalg.eig(f, left=True, right=True)
+    scale = max(float(np.abs(f).max()), 1e-300)
+    j = int(np.argmin(np.abs(vals)))
+    members = np.flatnonzero(np.abs(vals - vals[j]) <= CLUSTER * scale)
+    return right[:, members], left[:, members], complex(vals[members].mean())
+
+
+def _mean_derivative(x: Array, y: Array, df: Array) -> complex:
+    """Derivative of the cluster's mean eigenvalue: ``trace((Y^H X)^-1 Y^H dF X) / m``."""
+    yx = y.conj().T @ x
+    return complex(np.trace(np.linalg.solve(yx, y.conj().T @ df @ x)) / x.shape[1])
+
+
+def exact_onset(model: Model, thrust: float, omega: float, linearization: str | None = None,
+                fluid_frequency: float = 0.0, family: "ViscoelasticFamily | None" = None) -> ExactOnset:
+    """Newton on the exact eigenproblem ``F(i omega, T) v = 0`` (the mounts' laws, not their Prony
+    fits) from an onset ``(thrust, omega)``.
+
+    The unknowns are ``T`` and ``omega`` (for divergence, ``omega = 0``, where every law has its
+    static stiffness: ``T`` alone), the equation the eigenvalue ``mu(i omega, T)`` of ``F`` nearest
+    zero (the mean of a cluster of equal ones, so that the identical planes of a symmetric layout
+    keep the convergence quadratic), with its exact derivative ``y^H dF x / y^H x``;
+    ``dF/d omega = i dF/d lambda`` exactly, ``dF/dT`` by central differences of the linearization.
+    ``family``: the model's :class:`ViscoelasticFamily` when one exists already (same settings).
+    """
+    fam = family if family is not None else ViscoelasticFamily(model, linearization, fluid_frequency)
+
+    def dyn(t: float, lam: complex):
+        m, c, k, rho = fam.system(np.array([t]))
+        return dynamic_stiffness(lam, m[0], c[0], k[0], rho[0], model), (m[0], c[0], rho[0])
+
+    t, w = float(thrust), float(abs(omega))
+    flutter = w > 0.0
+    it = 0
+    converged = False
+    dt = dw = np.inf
+    for it in range(1, NEWTON_MAX + 1):
+        lam = 1j * w
+        f, (m, c, rho) = dyn(t, lam)
+        if not np.isfinite(f).all():
+            break
+        h = 1e-6 * max(abs(t), 1.0)
+        f_t = (dyn(t + h, lam)[0] - dyn(t - h, lam)[0]) / (2 * h)
+        try:
+            x, y, mu = _cluster(f)
+            b = _mean_derivative(x, y, f_t)
+            if flutter:
+                a = 1j * _mean_derivative(x, y, _d_dynamic_stiffness(lam, m, c, rho, model))
+                dw, dt = np.linalg.solve(np.array([[a.real, b.real], [a.imag, b.imag]]), [-mu.real, -mu.imag])
+            else:
+                dw, dt = 0.0, -mu.real / b.real
+        except (np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
+            break
+        if not (np.isfinite(dw) and np.isfinite(dt)):
+            break
+        t, w = t + float(dt), w + float(dw)
+        if abs(dt) <= NEWTON_TOL * max(abs(t), 1.0) and abs(dw) <= NEWTON_TOL * max(abs(w), 1.0):
+            converged = True
+            break
+    if not converged and np.isfinite(dt) and abs(dt) <= NEWTON_FLOOR * max(abs(t), 1.0) \
+            and abs(dw) <= NEWTON_FLOOR * max(abs(w), 1.0):
+        converged = True
+    if not converged:
+        return ExactOnset(float(thrust), float(omega), None, None, None, None, it)
+    return ExactOnset(float(thrust), float(omega), t, w, (t - thrust) / thrust if thrust else t - thrust,
+                      (w - abs(omega)) / max(abs(omega), 1.0), it)
+
+
+def viscoelastic_modes(model: Model, thrust: float = 0.0, linearization: str | None = None):
+    """Modes of the augmented system at ``thrust`` (a :class:`~impstab.linear.modes.ModalResult`).
+
+    Every eigenvalue of ``E^-1 A`` with ``omega >= 0`` is a mode, the real relaxation roots of
+    the internal variables included (``omega = 0``, ``sigma < 0``); shapes and the decoupling
+    table are those of the displacement states ``q``. Roots whose displacement part vanishes
+    (an internal variable that no motion of the body excites) are left out.
+    """
+    from .modes import ModalResult, _canonical_repeated, energy_shares
+
+    fam = ViscoelasticFamily(model, linearization)
+    m, c, k, rho = fam.system(np.array([float(thrust)]))
+    if not np.isfinite(k).all():
+        from ..errors import NumericalError
+
+        raise NumericalError(f"no static equilibrium found at thrust {thrust:.6g} N: the mounts cannot carry this thrust")
+    e, a = augmented_matrices(m, c, k, rho, fam.terms)  # type: ignore[attr-defined]
+    vals, vecs = np.linalg.eig(np.linalg.solve(e[0], a[0]))
+    scale = max(np.abs(vals).max(), 1e-300)
+    q = vecs[:6]
+    size = np.linalg.norm(q, axis=0) / np.maximum(np.linalg.norm(vecs, axis=0), 1e-300)
+    keep = ((vals.imag > 1e-12 * scale) | (np.abs(vals.imag) <= 1e-12 * scale)) & (size > 1e-10)
+    vals, vecs = vals[keep], q[:, keep]
+    vals = np.where(np.abs(vals.imag) <= 1e-12 * scale, vals.real + 0j, vals)
+    order = np.lexsort((vals.real, np.abs(vals.imag)))
+    vals, vecs = vals[order], vecs[:, order]
+    vecs = _canonical_repeated(vals, vecs, np.diag(m[0]))
+    big = np.argmax(np.abs(vecs), axis=0)
+    shapes = vecs / vecs[big, np.arange(vecs.shape[1])]
+    return ModalResult(float(thrust), fam.linearization, vals, shapes, energy_shares(shapes, m[0]))  # type: ignore[arg-type]
