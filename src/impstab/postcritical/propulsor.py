@@ -129,6 +129,8 @@ def propulsor_postcritical(
     intervals: int = DEFAULTS["intervals"],
     degree: int = DEFAULTS["degree"],
     progress: Callable[[int, float], None] | None = None,
+    branch: bool = True,
+    critical=None,
 ) -> PostcriticalResult:
     """Hopf analysis at the flutter onset of ``model`` and its branch of limit cycles.
 
@@ -153,6 +155,12 @@ def propulsor_postcritical(
         Initial collocation mesh intervals and polynomial degree.
     progress : callable, optional
         ``progress(points_done, thrust)`` after each continuation step.
+    branch : bool
+        Continue the branch of cycles (``False``: the Hopf analysis only; ``fold_thrust`` is then
+        None and ``stop_reason`` says the branch was not computed).
+    critical : CriticalThrust, optional
+        The linear onset when already known (anything with ``thrust``, ``kind``, ``omega`` and
+        ``linearization``, computed with the same ``thrust_max``); default :func:`impstab.critical_thrust`.
 
     Returns
     -------
@@ -163,7 +171,7 @@ def propulsor_postcritical(
 
     t_max = check_number("thrust_max", thrust_max if thrust_max is not None else model.analysis.thrust_max, "thrust")
     requested = _check_thrusts(thrusts, t_max)
-    crit = critical_thrust(model, thrust_max=t_max)
+    crit = critical if critical is not None else critical_thrust(model, thrust_max=t_max)
     settings = {"thrust_max": t_max, "max_points": int(max_points), "amplitude_max": float(amplitude_max),
                 "intervals": int(intervals), "degree": int(degree), "linearization": crit.linearization,
                 "requested_thrusts": list(requested)}
@@ -174,6 +182,14 @@ def propulsor_postcritical(
             critical_thrust=None, kind="none", omega=None, bifurcation=None,
             reason=f"no loss of stability up to thrust_max = {t_max:g} N: there is no onset to analyse",
             requested=requested, stable_below=math.inf, **base)
+    if crit.kind == "divergence":
+        # a real eigenvalue through zero: a fold (limit point) or pitchfork of equilibria, where the
+        # static equilibrium itself may cease to exist; no cycle is born
+        return PostcriticalResult.without_branch(
+            critical_thrust=crit.thrust, kind="divergence", omega=None, bifurcation="degenerate",
+            reason="divergence: a real eigenvalue crosses zero (a static instability: a fold or pitchfork of "
+                   "equilibria), so no limit cycle is born and there is no Lyapunov coefficient",
+            requested=requested, stable_below=crit.thrust, **base)
     system, ns = propulsor_system(model, crit.omega)
     x0 = ns.equilibrium(crit.thrust)
     hopf = hopf_analysis(system, x0, crit.thrust, omega=crit.omega if crit.kind == "flutter" else None)
@@ -183,6 +199,8 @@ def propulsor_postcritical(
         return PostcriticalResult.without_branch(
             critical_thrust=hopf.parameter, kind=kind, omega=hopf.omega, bifurcation="degenerate",
             reason=hopf.reason, requested=requested, stable_below=hopf.parameter, hopf=hopf, **base)
+    if not branch:
+        return PostcriticalResult.from_hopf(hopf=hopf, kind=kind, requested=requested, **base)
     parameter_scale = DEFAULTS["parameter_share"] * hopf.parameter
     branch = continue_cycles(system, hopf, p_max=t_max, p_min=0.0, parameters=requested,
                              amplitude_max=float(amplitude_max), max_points=int(max_points), ds=DEFAULTS["ds"],

@@ -164,6 +164,17 @@ class PostcriticalResult:
                    stop_reason=branch.stop_reason, warnings=warnings, **base)
 
     @classmethod
+    def from_hopf(cls, *, hopf, kind, requested, **base) -> "PostcriticalResult":
+        """The Hopf analysis alone (the branch not computed)."""
+        res = cls.without_branch(critical_thrust=hopf.parameter, kind=kind, omega=hopf.omega,
+                                 bifurcation=hopf.bifurcation, reason=hopf.reason, requested=requested,
+                                 stable_below=hopf.parameter, hopf=hopf, **base)
+        from dataclasses import replace
+
+        return replace(res, lyapunov_coefficient=hopf.lyapunov_coefficient, lyapunov_error=hopf.lyapunov_error,
+                       stop_reason="the branch of cycles was not computed")
+
+    @classmethod
     def without_branch(cls, *, critical_thrust, kind, omega, bifurcation, reason, requested, stable_below,
                        hopf=None, **base) -> "PostcriticalResult":
         n = len(requested)

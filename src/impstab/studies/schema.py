@@ -42,7 +42,8 @@ from pydantic import (BaseModel, ConfigDict, Discriminator, Field, StrictBool, S
 from ..limits import MAX_TEXT
 from ..model.schema import Finite, Integer, Positive, Text, integer
 
-__all__ = ["StudyFile", "ParameterSpec", "RangeSpec", "DistributionSpec", "OUTPUTS", "DEFAULT_OUTPUTS"]
+__all__ = ["StudyFile", "ParameterSpec", "RangeSpec", "DistributionSpec", "OUTPUTS", "DEFAULT_OUTPUTS",
+           "POSTCRITICAL_OUTPUTS"]
 
 #: every output a study can store, with its units and meaning
 OUTPUTS = {
@@ -56,7 +57,13 @@ OUTPUTS = {
     "modes": ("", "dofs with at least 5 % of the kinetic energy of the critical mode"),
     "thrust_max": ("N", "upper end of the critical-thrust search"),
     "operating_thrust": ("N", "operating thrust"),
+    "lyapunov_coefficient": ("1/s", "first Lyapunov coefficient l1 of the Hopf point at the onset (Kuznetsov's "
+                                    "normalisation, q^H q = 1 on the 12 SI states; < 0 benign, > 0 dangerous)"),
+    "bifurcation": ("", "supercritical, subcritical, degenerate or none (no onset up to thrust_max)"),
+    "fold_thrust": ("N", "lowest thrust of a fold of limit cycles on the computed branch (NaN: no fold)"),
 }
+#: outputs that need the post-critical analysis of each design (impstab.postcritical)
+POSTCRITICAL_OUTPUTS = ("lyapunov_coefficient", "bifurcation", "fold_thrust")
 DEFAULT_OUTPUTS = ("critical_thrust", "kind", "frequency_hz", "margin", "undamped_critical_thrust")
 
 #: one value of a list of values: checked against the rule of its parameter's field later
