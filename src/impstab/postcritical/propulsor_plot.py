@@ -47,8 +47,7 @@ def plot_postcritical(result, ax=None, dof=None):
         else:
             side = "left" if op < lo else "right"
             ax.plot([], [], " ", label=f"operating thrust {op:.6g} N (off the diagram, {side})")
-    ax.set_title(f"{result.model_name}: limit cycles past the onset ({result.bifurcation or result.kind})",
-                 fontsize="medium")
+    ax.set_title(f"{result.model_name}: {result.bifurcation or result.kind} onset", fontsize="medium")
     ax.legend(loc="best", fontsize="small")
     return ax
 
