@@ -230,7 +230,7 @@ def test_user_strings_are_escaped_everywhere(evil):
     assert [s.name for s in rep.sections if s.status == "failed"] == []
     # the figures carry the name as text, escaped, and the dollar signs as they are (no mathtext)
     svgs = re.findall(r"<svg\b.*?</svg>", html, re.S)
-    assert len(svgs) == 3
+    assert len(svgs) == 4                        # with the post-critical diagram
     titled = [s for s in svgs if "&lt;script&gt;" in s]
     assert len(titled) >= 2 and all("$x^2$" in s for s in titled)
 
@@ -394,7 +394,7 @@ def test_statistics_hook_on_a_sampled_study(tmp_path, monkeypatch):
 def test_report_object(iso, tmp_path):
     rep, _, _ = iso
     assert re.match(r"Report\('isolated three-mount IMP: stability report': model report, 9 sections "
-                    r"\(8 computed, 1 not computed\), 4 figures, \d+ tables, \d+ kB\)", repr(rep))
+                    r"\(9 computed\), 5 figures, \d+ tables, \d+ kB\)", repr(rep))
     frame = rep._repr_html_()
     assert frame.startswith('<iframe title="isolated three-mount IMP: stability report" sandbox=""')
     assert "<svg" not in frame and "&lt;svg" in frame
