@@ -47,7 +47,7 @@ POINTS = 50
 #: target accuracy of the settled amplitude (relative)
 SETTLE = 1e-4
 WINDOW_PERIODS = 20
-MAX_WINDOWS = 5000
+MAX_WINDOWS = 500
 
 
 def _extreme(y, sign):
@@ -65,6 +65,7 @@ def _extreme(y, sign):
 def brute_force(model, thrusts, tc, period):
     """Amplitudes (pitch) at each thrust by integrating to steady state; returns (amplitudes, sim seconds)."""
     amps = []
+    unsettled: list[float] = []
     simulated = 0.0
     state = None
     for t in thrusts:
@@ -76,7 +77,7 @@ def brute_force(model, thrusts, tc, period):
             simulated += WINDOW_PERIODS * period
             y = run.deviation + run.equilibrium
             tail = run.time >= run.time[-1] - 1.05 * period
-            amp = 0.5 * (_extreme(y[tail, :6], 1.0) + _extreme(y[tail, :6], -1.0))
+            amp = 0.5 * (_extreme(y[tail, :6], 1.0) - _extreme(y[tail, :6], -1.0))
             z = run.deviation[-1]
             pert = {"displacement": z[:6], "velocity": z[6:]}
             if last is not None:
@@ -84,15 +85,16 @@ def brute_force(model, thrusts, tc, period):
                 # geometric convergence: the remaining error is change * r / (1 - r), r the ratio of
                 # successive changes
                 r = min(change / prev, 0.999) if prev else 0.5
-                if change * r / (1.0 - r) < SETTLE and change < SETTLE:
+                # (or a change at the sampling noise floor, a tenth of the target)
+                if change < 0.1 * SETTLE or (change * r / (1.0 - r) < SETTLE and change < SETTLE):
                     break
                 prev = change
             last = amp
         else:
-            raise RuntimeError(f"not settled at T = {t:g} N after {MAX_WINDOWS} windows")
+            unsettled.append(float(t))          # counted and reported, its last window kept
         state = run.deviation[-1]        # deviation from this thrust's equilibrium, close to the next one's
         amps.append(amp[4])
-    return np.array(amps), simulated
+    return np.array(amps), simulated, unsettled
 
 
 def main() -> None:
@@ -115,11 +117,14 @@ def main() -> None:
           f"stop: {res.stop_reason}; max |mu_trivial - 1| = {trivial:.1e}; all stable: {bool(res.branch_stable.all())}")
 
     t0 = time.perf_counter()
-    bf_amp, simulated = brute_force(model, thrusts, tc, period)
+    bf_amp, simulated, unsettled = brute_force(model, thrusts, tc, period)
     t_brute = time.perf_counter() - t0
     err = np.abs(bf_amp / pc_amp - 1.0)
     print(f"time integration to steady state: {POINTS} thrusts, {simulated:.0f} s simulated, {t_brute:.2f} s; "
           f"settled to {SETTLE:g} relative in {WINDOW_PERIODS}-period windows")
+    if unsettled:
+        print(f"not settled within {MAX_WINDOWS} windows at {len(unsettled)} thrusts: "
+              + ", ".join(f"{t:.1f}" for t in unsettled) + " N (their last window is compared)")
     print(f"{'thrust (N)':>12} {'pitch amp (rad)':>16} {'brute force':>14} {'rel. diff':>10}")
     for k in range(0, POINTS, 7):
         print(f"{thrusts[k]:12.2f} {pc_amp[k]:16.8g} {bf_amp[k]:14.8g} {err[k]:10.2e}")
@@ -130,7 +135,8 @@ def main() -> None:
     print(json.dumps({"speedup_vs_time_integration": t_brute / t_branch, "amplitude_rel_err": float(err.max()),
                       "branch_seconds": t_branch, "time_integration_seconds": t_brute, "points": POINTS,
                       "cycles_computed": int(cycles), "simulated_seconds": simulated,
-                      "max_trivial_multiplier_error": trivial, "speedup_vs_auto07p": None}))
+                      "max_trivial_multiplier_error": trivial, "unsettled_thrusts": len(unsettled),
+                      "speedup_vs_auto07p": None}))
 
 
 if __name__ == "__main__":
