@@ -146,6 +146,11 @@ RANGES: dict[str, Range] = {
     "stiffness": Range(0.0, 1e13, "N/m", "a mount stiffness"),
     "cubic_stiffness": Range(-1e20, 1e20, "N/m^3", "a cubic mount stiffness"),
     "clearance": Range(0.0, 10.0, "m", "a snubber clearance"),
+    # beam mounts ([mounts.beam])
+    "bore": Range(0.0, 1e3, "m", "an inner diameter (0: solid)"),
+    "modulus": Range(1e3, 1e13, "Pa", "an elastic modulus"),
+    "shear_coefficient": Range(1e-3, 1.0, "", "a Timoshenko shear coefficient"),
+    "material_density": Range(0.0, 1e5, "kg/m^3", "a material density (0: massless)"),
     "stiffness_entry": Range(-1e13, 1e13, "N/m, N or N m/rad", "a 6x6 stiffness entry"),
     "damping": Range(0.0, 1e11, "N s/m", "a mount damping"),
     "damping_entry": Range(-1e11, 1e11, "N s/m, N s or N m s/rad", "a 6x6 damping entry"),

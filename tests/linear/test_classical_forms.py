@@ -18,7 +18,7 @@ from impstab.linear.tangent import classical_forms, linearize_batch
 from impstab.model import load_model
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "examples").glob("*.toml"))
-EXAMPLES = [p for p in EXAMPLES if not p.name.startswith("study_")]
+EXAMPLES = [p for p in EXAMPLES if not p.name.startswith(("study_", "optimize_"))]  # model files only
 
 
 # The kernels are called with arguments of the types the library passes (read-only thrust

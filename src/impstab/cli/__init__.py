@@ -32,6 +32,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "postcritical": ("postcritical", "Hopf analysis at the onset and the branch of limit cycles past it."),
     "response": ("response", "Forced response and force transmissibility |F_hull| / |F_in| to the hull."),
     "sweep": ("sweep", "Run the design study STUDY_FILE (or resume it) into a zarr store."),
+    "optimize": ("optimize", "Search the design variables of OPT_FILE for the best isolation that meets its constraints."),
     "map": ("sweep", "Draw the stability map of the study in STORE (PNG, SVG or PDF by the suffix)."),
     "schema": ("schema", "Print the JSON Schema of model files (or of study files, --study)."),
     "stats": ("stats", "Distribution of the critical thrust and margin, probability of missing a required margin and Sobol indices of the random, Sobol or Saltelli study in STORE."),

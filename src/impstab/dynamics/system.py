@@ -47,6 +47,9 @@ class DynamicSystem:
 def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
     """Pack ``model`` for the kernels: mounts, mass properties, thrust line, propeller."""
     from ..linear.linearize import pack_model
+    from ..linear.mount_dofs import refuse_massive_beams
+
+    refuse_massive_beams(model, "the nonlinear time histories (simulate, postcritical)")
 
     pk = pack_model(model)
     nm = pk.positions.shape[0]

@@ -148,6 +148,18 @@ def _modes(part: NDArray[np.float64] | None) -> tuple[str, ...]:
     return tuple(n for n, s in zip(DOF_NAMES, part) if s >= PARTICIPATION_THRESHOLD)
 
 
+def _body_part(mode, participation):
+    """The body's 6 dofs of a mode and its participation when the family carries internal mount
+    dofs (massive beam mounts): the shares renormalised over the body dofs."""
+    if mode is not None and len(mode) > 6:
+        mode = mode[:6] / mode[:6][np.argmax(np.abs(mode[:6]))] if np.any(mode[:6]) else mode[:6]
+    if participation is not None and len(participation) > 6:
+        body = np.asarray(participation[:6], dtype=float)
+        total = body.sum()
+        participation = body / total if total > 0 else body
+    return mode, participation
+
+
 def critical_thrust(
     model: Model,
     *,
@@ -198,13 +210,14 @@ def critical_thrust(
     else:
         und = res
     notes = operating_point_warnings(res.load, model.thrust.operating, t_max)
+    shape, part = _body_part(res.mode, res.participation)
     return CriticalThrust(
         thrust=res.load,
         kind=res.kind,
         omega=res.omega,
-        modes=_modes(res.participation),
-        participation=res.participation,
-        mode_shape=res.mode,
+        modes=_modes(part),
+        participation=part,
+        mode_shape=shape,
         thrust_max=t_max,
         operating_thrust=model.thrust.operating,
         undamped_thrust=und.load,

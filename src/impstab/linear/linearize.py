@@ -152,12 +152,19 @@ class ModelFamily:
         False removes every damper (the undamped companion of a damped model).
     fluid_frequency : float
         Frequency (Hz) at which compressible fluid coefficients are taken (0: incompressible).
+    mount_dofs : bool
+        Append the internal finite-element dofs of massive beam mounts
+        (:mod:`impstab.linear.mount_dofs`): ``n = 6 + n_internal`` and :meth:`matrices`,
+        :meth:`affine_parts` return the grown system (:meth:`evaluate` stays the 6-dof body
+        system with each mount as its static stiffness). False, or a model without massive beam
+        mounts: ``n = 6``.
     """
 
     model: Model
     linearization: str | None = None
     damped: bool = True
     fluid_frequency: float = 0.0
+    mount_dofs: bool = True
 
     def __post_init__(self) -> None:
         lin = self.linearization or self.model.analysis.linearization
@@ -167,6 +174,10 @@ class ModelFamily:
         pk = pack_model(self.model, damped=self.damped, fluid_frequency=self.fluid_frequency)
         object.__setattr__(self, "_packed", pk)
         object.__setattr__(self, "_affine", self._affine_form(pk, lin))
+        # -- massive beam mounts: internal dofs (impstab.linear.mount_dofs) --
+        from .mount_dofs import mount_dofs
+
+        object.__setattr__(self, "_internal", mount_dofs(self.model) if self.mount_dofs else None)
 
     @staticmethod
     def _affine_form(pk: PackedModel, lin: str):
@@ -187,7 +198,16 @@ class ModelFamily:
         g = g1[None] * (pk.polar_inertia * pk.spins(p))[:, None, None]
         return (np.broadcast_to(m, shape), np.broadcast_to(d, shape), g, k0[None] + p[:, None, None] * k1[None])
 
-    n = 6
+    @property
+    def n(self) -> int:
+        """Number of dofs: 6, plus the internal dofs of massive beam mounts (``mount_dofs``)."""
+        internal = self._internal  # type: ignore[attr-defined]
+        return 6 if internal is None else 6 + internal.n
+
+    @property
+    def internal(self):
+        """The :class:`~impstab.linear.mount_dofs.MountDofs` appended to the body's, or None."""
+        return self._internal  # type: ignore[attr-defined]
 
     @property
     def packed(self) -> PackedModel:
@@ -254,13 +274,30 @@ class ModelFamily:
         if pk.speed_law == "sqrt-thrust" and pk.polar_inertia * pk.speed != 0.0:
             return None
         m, d, k0, k1, g1 = self._affine  # type: ignore[attr-defined]
-        return m, d, g1 * pk.polar_inertia * pk.speed, k0, k1
+        g = g1 * pk.polar_inertia * pk.speed
+        if self.internal is not None:
+            (m, d, g, k0), k1 = self._grow(m, d, g, k0), self._grow_load(k1)
+        return m, d, g, k0, k1
+
+    def _grow(self, m, d, g, k, rotations=None):
+        stack = lambda a: np.asarray(a, dtype=float)[None]  # noqa: E731
+        return tuple(a[0] for a in self.internal.augment(stack(m), stack(d), stack(g), stack(k), rotations))
+
+    def _grow_load(self, k1):
+        """The load part of an affine K on the grown dofs: the beams carry no thrust terms."""
+        out = np.zeros((self.n, self.n))
+        out[:6, :6] = k1
+        return out
 
     def matrices(self, p: Array):
         p = np.atleast_1d(np.asarray(p, dtype=float))
         if self._affine is not None:  # type: ignore[attr-defined]
-            return self._affine_matrices(p)
-        m, d, g, k, _, _ = self.evaluate(p, strict=False)
+            m, d, g, k = self._affine_matrices(p)
+            r0 = None
+        else:
+            m, d, g, k, _, r0 = self.evaluate(p, strict=False)
+        if self.internal is not None:
+            return self.internal.augment(np.asarray(m), np.asarray(d), np.asarray(g), np.asarray(k), r0)
         return m, d, g, k
 
 

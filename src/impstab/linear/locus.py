@@ -240,6 +240,9 @@ def locus(
         Also compute the critical thrust (damped and undamped) over the same range and store
         it in the result (the figure marks it).
     """
+    from .mount_dofs import refuse_massive_beams
+
+    refuse_massive_beams(model, "the eigenvalue locus")
     if thrusts is None:
         if steps < 1:
             raise ModelError("steps", steps, "must be at least 1")

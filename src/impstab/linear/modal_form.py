@@ -82,7 +82,7 @@ def modal_form(model: Model, n_modes: int | None = None, *, modal_damping: bool 
     n = 6 if n_modes is None else int(n_modes)
     if not 1 <= n <= 6:
         raise ModelError("n_modes", n_modes, "must be between 1 and 6")
-    fam = ModelFamily(model, "classical")
+    fam = ModelFamily(model, "classical", mount_dofs=False)  # the rigid-body modal form: mounts as their static 6 x 6
     m, d, _, k = fam.matrices(np.array([0.0, 1.0]))
     k_c, k_g = k[0], -(k[1] - k[0])
     w2, phi = sla.eigh(0.5 * (k_c + k_c.T), m[0])

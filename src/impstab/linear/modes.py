@@ -248,6 +248,9 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
     With compressible fluid loading each mode is computed with the added mass and radiation
     damping at its own frequency, iterated to consistency (fixed point on the frequency).
     """
+    from .mount_dofs import refuse_massive_beams
+
+    refuse_massive_beams(model, "the modal analysis")
     base = modes_of_system(linearize(model, thrust, linearization))
     if not model.fluid.compressible:
         return base

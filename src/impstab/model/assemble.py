@@ -17,6 +17,7 @@ from pydantic import ValidationError
 
 from ..errors import ModelError
 from ..limits import MAX_FILE_BYTES, MAX_LIST_ITEMS, MAX_MOUNTS, MAX_NESTING, MIN_DIRECTION, RANGES
+from .beam import BeamMount, tip_stiffness
 from .body import RigidBody
 from .isolation_specs import excitation_from_spec, foundation_from_spec
 from .fluid import FluidLoading, Hull
@@ -184,13 +185,37 @@ def _nonlinear_law(spec, axis: np.ndarray, field: str) -> NonlinearLaw | None:
     return None if law.is_linear else law
 
 
+# -- beam mounts ([mounts.beam]) ----------------------------------------------------------------
+def _beam(m, f: str) -> BeamMount:
+    """The beam of a mount table; its keys exclude the spring keys and the nonlinear law."""
+    for key in ("k_axial", "k_shear", "stiffness"):
+        if getattr(m, key) is not None:
+            raise ModelError(f"{f}.{key}", "6x6" if key == "stiffness" else getattr(m, key),
+                             "give either [mounts.beam] or k_axial/k_shear or 'stiffness', not two of them")
+    for key in _LAW_KEYS:
+        if getattr(m, key) != 0.0:
+            raise ModelError(f"{f}.{key}", getattr(m, key),
+                             "is read only with k_axial/k_shear (an axial-shear mount), not with [mounts.beam]")
+    b = m.beam
+    if not b.inner_diameter < b.outer_diameter:
+        raise ModelError(f"{f}.beam.inner_diameter", b.inner_diameter,
+                         f"must be below outer_diameter ({b.outer_diameter:g} m)")
+    return BeamMount(b.length, b.outer_diameter, b.inner_diameter, b.youngs_modulus, b.shear_modulus,
+                     b.shear_coefficient, b.density)
+# -- end of beam mounts --------------------------------------------------------------------------
+
+
 def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
     mounts: list[Mount] = []
     for i, m in enumerate(doc.mounts):
         f = f"mounts[{i}]"
         pos = np.asarray(m.position, float)
         law = None
-        if m.stiffness is not None:
+        beam = None
+        if m.beam is not None:
+            beam = _beam(m, f)
+            k6 = tip_stiffness(beam, unit_vector(m.axis, f"{f}.axis"))
+        elif m.stiffness is not None:
             for key in ("k_axial", "k_shear"):
                 if getattr(m, key) is not None:
                     raise ModelError(f"{f}.{key}", getattr(m, key), "give either 'stiffness' (6x6) or k_axial/k_shear, not both")
@@ -203,7 +228,7 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
         else:
             for key in ("k_axial", "k_shear"):
                 if getattr(m, key) is None:
-                    raise ModelError(f"{f}.{key}", None, "is required (or give a full 6x6 'stiffness')")
+                    raise ModelError(f"{f}.{key}", None, "is required (or give a full 6x6 'stiffness' or [mounts.beam])")
             axis = unit_vector(m.axis, f"{f}.axis")
             k6 = np.zeros((6, 6))
             k6[:3, :3] = axial_shear_matrix(axis, m.k_axial, m.k_shear)
@@ -218,7 +243,7 @@ def _mounts(doc: ModelFile) -> tuple[Mount, ...]:
             c6 = np.zeros((6, 6))
             c6[:3, :3] = axial_shear_matrix(axis, m.c_axial, m.c_shear)
         mounts.append(Mount(pos, k6, c6, unit_vector(m.axis, f"{f}.axis"), m.rated_force, m.max_deflection,
-                            nonlinear=law))
+                            nonlinear=law, beam=beam))
     for i, ring in enumerate(doc.mount_rings):
         f = f"mount_rings[{i}]"
         axis = unit_vector(ring.axis, f"{f}.axis")

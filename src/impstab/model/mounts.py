@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..kinematics import rigid_map6
+from .beam import BeamMount
 
 __all__ = ["Mount", "NonlinearLaw", "axial_shear_matrix", "ring_positions", "condense", "elastic_stiffness", "mount_damping"]
 
@@ -128,6 +129,10 @@ class Mount:
     nonlinear : NonlinearLaw or None
         Cubic springs and snubber acting on the translation deflection, in addition to
         ``stiffness``; None (or a linear law): the mount is linear.
+    beam : BeamMount or None
+        The Timoshenko beam the mount is (:mod:`impstab.model.beam`), along ``axis``; then
+        ``stiffness`` is its clamped-free tip stiffness ``K_tip``, and a beam with mass brings
+        internal finite-element dofs to the stability analysis.
     """
 
     position: Array
@@ -137,6 +142,7 @@ class Mount:
     rated_force: float | None = None
     max_deflection: float | None = None
     nonlinear: NonlinearLaw | None = None
+    beam: BeamMount | None = None
 
     def __repr__(self) -> str:
         from ..display import mount_text
@@ -172,6 +178,22 @@ class Mount:
         c[:3, :3] = axial_shear_matrix(axis, c_axial, c_shear)
         law = NonlinearLaw(np.asarray(axis, float), k3_axial, k3_shear, snubber_clearance, snubber_stiffness)
         return cls(np.asarray(position, float), k, c, axis, nonlinear=None if law.is_linear else law)
+
+    # -- beam mounts -----------------------------------------------------------------------------
+    @classmethod
+    def beam_mount(cls, position: Array, axis: Array, beam: BeamMount, damping: Array | None = None) -> "Mount":
+        """A Timoshenko beam mount along ``axis`` with its body end at ``position``: ``stiffness`` is
+        its tip stiffness :func:`~impstab.model.beam.tip_stiffness` (hull frame)."""
+        from .beam import tip_stiffness
+
+        c = np.zeros((6, 6)) if damping is None else np.asarray(damping, float)
+        return cls(np.asarray(position, float), tip_stiffness(beam, axis), c, axis, beam=beam)
+
+    @property
+    def is_massive_beam(self) -> bool:
+        """True when the mount is a beam with mass (internal dofs in the dynamics)."""
+        return self.beam is not None and self.beam.is_massive
+    # -- end of beam mounts ------------------------------------------------------------------------
 
     @property
     def is_nonlinear(self) -> bool:

@@ -80,6 +80,23 @@ MODEL_REFERENCE: dict[str, E] = {
                                     "clearance; 0 means none, > 0 needs snubber_stiffness.", "snubber clearance"),
     "mounts[].snubber_stiffness": E("N/m", "Stiffness of the motion limiter beyond its clearance; required > 0 with "
                                     "snubber_clearance, and only with it.", "snubber stiffness"),
+    # [mounts.beam] (impstab.model.beam, docs/mounts.md)
+    "mounts[].beam": E("", "A Timoshenko beam along the mount axis, instead of k_axial/k_shear or stiffness: hull end "
+                       "clamped at position - length * axis, body end at position. Massless, it is exactly the 6 x 6 "
+                       "stiffness K_tip (inverse of its clamped-free tip flexibility); with density > 0 its finite "
+                       "elements add internal dofs to the stability analysis (docs/mounts.md)."),
+    "mounts[].beam.length": E("m", "Free length L of the beam, from the clamped hull end to the body end.",
+                              "beam length"),
+    "mounts[].beam.outer_diameter": E("m", "Outer diameter of the circular section.", "beam outer diameter"),
+    "mounts[].beam.inner_diameter": E("m", "Inner diameter of a hollow section (0: solid); below outer_diameter.",
+                                      "beam inner diameter"),
+    "mounts[].beam.youngs_modulus": E("Pa", "Young's modulus E (axial and bending stiffness).", "beam Young's modulus"),
+    "mounts[].beam.shear_modulus": E("Pa", "Shear modulus G (torsion and shear deformation).", "beam shear modulus"),
+    "mounts[].beam.shear_coefficient": E("1", "Timoshenko shear coefficient kappa; default Cowper's value for the "
+                                         "(hollow) circular section with nu = E / (2 G) - 1.",
+                                         "beam shear coefficient"),
+    "mounts[].beam.density": E("kg/m^3", "Density of the beam material; 0 (default): massless; > 0: the mount has its "
+                               "own mass (internal finite-element dofs).", "beam density"),
     # [[mount_rings]]
     "mount_rings": E("", "Rings of identical mounts, equally spaced around the axis (count mounts on a circle of "
                      "the given radius in the plane at x)."),

@@ -229,6 +229,20 @@ class FluidSpec(_Strict):
     added_mass: Optional[AddedMass6] = None
 
 
+# -- beam mounts ([mounts.beam], impstab.model.beam) -------------------------------------------
+class BeamSpec(_Strict):
+    """A Timoshenko beam along the mount axis, hull end clamped, body end at the mount position."""
+
+    length: Size                                   # m, free length
+    outer_diameter: Size                           # m, circular section
+    inner_diameter: number("bore") = 0.0           # m, 0: solid
+    youngs_modulus: number("modulus")              # Pa
+    shear_modulus: number("modulus")               # Pa
+    shear_coefficient: Optional[number("shear_coefficient")] = None  # default: Cowper's value
+    density: number("material_density") = 0.0     # kg/m^3, > 0: the mount has its own mass
+# -- end of beam mounts --------------------------------------------------------------------------
+
+
 class MountSpec(_Strict):
     position: Point3
     axis: Direction3 = [1.0, 0.0, 0.0]
@@ -245,6 +259,7 @@ class MountSpec(_Strict):
     k3_shear: number("cubic_stiffness") = 0.0
     snubber_clearance: number("clearance") = 0.0
     snubber_stiffness: number("stiffness") = 0.0
+    beam: Optional[BeamSpec] = None             # a Timoshenko beam instead of k_axial/k_shear/stiffness
 
 
 class MountRingSpec(_Strict):

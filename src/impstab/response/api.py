@@ -10,6 +10,7 @@ hull given by the model's ``[foundation]`` (rigid by default).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import ModelError
 from ..linear.linearize import linearize
 from ..linear.modes import modes
+from ..linear.system import LinearSystem
 from ..model.foundation import Foundation
 from ..model.model import DOF_NAMES, Model
 from .core import harmonic_response
@@ -24,7 +26,8 @@ from .excitation import excitation_lines, shaft_rate, unit_load
 from .fluid import fluid_dynamic_stiffness, fluid_spectrum
 from .result import ForcedResponse
 
-__all__ = ["frequency_response", "excitation_response", "check_frequencies", "MAX_FREQUENCIES", "default_thrust"]
+__all__ = ["frequency_response", "excitation_response", "check_frequencies", "MAX_FREQUENCIES", "default_thrust",
+           "DesignInputs", "design_inputs", "solve_designs"]
 
 #: most frequencies in one response (memory: about 1 kB per frequency with four mounts)
 MAX_FREQUENCIES = 100_000
@@ -76,15 +79,48 @@ def _hull_stiffness(model: Model, foundation, f: NDArray) -> tuple[NDArray | Non
     return s, "compliant (" + ", ".join(kinds) + "): isotropic point impedance per attachment, uncoupled"
 
 
-def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearization: str | None, foundation,
-             input_name: str, source: tuple[str, ...]) -> ForcedResponse:
+@dataclass(frozen=True, eq=False)
+class DesignInputs:
+    """The arrays of one design that :func:`~impstab.response.core.harmonic_response` stacks.
+
+    Attributes
+    ----------
+    linear : LinearSystem
+        The linearization at the response thrust.
+    positions : (nm, 3);  mount_stiffness, mount_damping : (nm, 6, 6)
+    fluid : (nf, 6, 6) complex or None
+        Frequency-dependent fluid part of the dynamic stiffness (compressible fluid only).
+    hull : (nf, nm) complex or None
+        Hull dynamic stiffness at each attachment (None: rigid).
+    settings : dict
+        ``fluid`` and ``foundation`` in words.
+    """
+
+    linear: LinearSystem
+    positions: NDArray
+    mount_stiffness: NDArray
+    mount_damping: NDArray
+    fluid: NDArray | None
+    hull: NDArray | None
+    settings: dict
+
+
+def design_inputs(model: Model, f: NDArray, thrust: float, linearization: str | None = None,
+                  foundation=None) -> DesignInputs:
+    """Linearize ``model`` at ``thrust`` and gather its response inputs at frequencies ``f`` (Hz).
+
+    The single route from a model to the stacked arrays of :func:`harmonic_response`, used by
+    :func:`frequency_response` (one design) and by design studies (many designs in one solve).
+    """
+    from ..linear.mount_dofs import refuse_massive_beams
+
+    refuse_massive_beams(model, "the forced response")
     lin = linearize(model, thrust, linearization)
-    settings: dict = {"model": model.name, "model_source": model.source or ""}
+    settings: dict = {}
     fluid_extra = None
     spectrum = fluid_spectrum(model, f)
     if spectrum is not None:
         fluid_extra, _, _ = fluid_dynamic_stiffness(model, spectrum, lin.rotation)
-        fluid_extra = fluid_extra[None]
         settings["fluid"] = (
             f"compressible baffled cylinder at every frequency ({spectrum.method}, {spectrum.evaluations} "
             f"evaluations, interpolation error <= {spectrum.interpolation_error:.1e}, "
@@ -94,14 +130,43 @@ def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearizat
         settings["fluid"] = model.fluid.model if model.fluid.model == "none" else f"{model.fluid.model} (frequency independent)"
     hull, hull_text = _hull_stiffness(model, foundation, f)
     settings["foundation"] = hull_text
-    pos = np.array([m.position for m in model.mounts], dtype=float)[None]
-    km = np.array([m.stiffness for m in model.mounts], dtype=float)[None]
-    cm = np.array([m.damping for m in model.mounts], dtype=float)[None]
-    sol = harmonic_response(
-        lin.M[None], lin.D[None], lin.G[None], lin.K[None], lin.rotation[None], pos, km, cm,
-        2.0 * np.pi * f, loads[None], fluid=fluid_extra, foundation=hull,
-        fluid_damping=np.zeros((1, 6, 6)),  # linearize takes the fluid at 0 Hz: no radiation damping in lin.D
+    return DesignInputs(
+        linear=lin,
+        positions=np.array([m.position for m in model.mounts], dtype=float).reshape(-1, 3),
+        mount_stiffness=np.array([m.stiffness for m in model.mounts], dtype=float).reshape(-1, 6, 6),
+        mount_damping=np.array([m.damping for m in model.mounts], dtype=float).reshape(-1, 6, 6),
+        fluid=fluid_extra, hull=None if hull is None else hull[0], settings=settings,
     )
+
+
+def solve_designs(designs: Sequence[DesignInputs], f: NDArray, loads: NDArray):
+    """One :func:`harmonic_response` over designs of the same mount count (a shared frequency grid).
+
+    ``loads`` is ``(6,)``, ``(nf, 6)`` or ``(nd, nf, 6)``. Designs without fluid or foundation
+    terms get zeros (fluid) or an infinite hull stiffness (rigid) beside those that have them.
+    """
+    stack = lambda name: np.stack([getattr(d, name) for d in designs])  # noqa: E731
+    lin = lambda name: np.stack([getattr(d.linear, name) for d in designs])  # noqa: E731
+    nm = designs[0].positions.shape[0]
+    fluid = None
+    if any(d.fluid is not None for d in designs):
+        fluid = np.stack([np.zeros((f.size, 6, 6), complex) if d.fluid is None else d.fluid for d in designs])
+    hull = None
+    if any(d.hull is not None for d in designs):
+        hull = np.stack([np.full((f.size, nm), np.inf, complex) if d.hull is None else d.hull for d in designs])
+    return harmonic_response(
+        lin("M"), lin("D"), lin("G"), lin("K"), lin("rotation"), stack("positions"), stack("mount_stiffness"),
+        stack("mount_damping"), 2.0 * np.pi * f, loads, fluid=fluid, foundation=hull,
+        fluid_damping=np.zeros((len(designs), 6, 6)),  # linearize takes the fluid at 0 Hz: no radiation damping in D
+    )
+
+
+def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearization: str | None, foundation,
+             input_name: str, source: tuple[str, ...]) -> ForcedResponse:
+    inputs = design_inputs(model, f, thrust, linearization, foundation)
+    lin = inputs.linear
+    settings: dict = {"model": model.name, "model_source": model.source or "", **inputs.settings}
+    sol = solve_designs([inputs], f, loads[None])
     md = modes(model, thrust, linearization)
     warnings: list[str] = []
     if not md.stable:

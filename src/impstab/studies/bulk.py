@@ -116,6 +116,8 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
         return None
     if model.is_nonlinear:
         return None
+    if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: per-variant path
+        return None
     for seg in segments:
         if seg[0] == "mounts" and seg[2] in ("k_axial", "k_shear") and doc.mounts[seg[1]].stiffness is not None:
             return None

@@ -17,11 +17,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ModelError
-from ..linear.batch import STATUSES, critical_thrust_batch
+from ..linear.batch import STATUSES, AffineDesign, critical_thrust_batch
 from ..model.assemble import model_from_dict
 from .bulk import assemble_bulk
+from .isolation import IsolationSettings, isolation_outputs
 from .paths import variant_dict
-from .schema import POSTCRITICAL_OUTPUTS
+from .schema import ISOLATION_OUTPUTS, POSTCRITICAL_OUTPUTS
 
 __all__ = ["ChunkTask", "ChunkResult", "evaluate_chunk", "variant_dict", "CODE_OUTPUTS"]
 
@@ -56,6 +57,7 @@ class ChunkTask:
     columns: tuple[NDArray, ...]
     outputs: tuple[str, ...]
     model_name: str = "model"
+    isolation: IsolationSettings | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,6 +138,19 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
         "kind": res.kind,
         "undamped_kind": res.undamped_kind,
     }
+    iso_names = tuple(n for n in task.outputs if n in ISOLATION_OUTPUTS
+                      or (task.isolation is not None and any(p.name == n for p in task.isolation.at)))
+    if iso_names:
+        full = [m if m is None or not isinstance(m, AffineDesign) else
+                model_from_dict(variant_dict(task.base_model, task.segments, [c[j] for c in task.columns]), name=task.model_name)
+                for j, m in enumerate(models)]
+        iso, iso_messages = isolation_outputs(full, task.isolation, iso_names)
+        values.update(iso)
+        for j, text in iso_messages.items():
+            if status[j] == 0:
+                status[j] = STATUSES.index("numerical_failure")
+                message[j] = text
+        failed = status != 0
     if any(name in POSTCRITICAL_OUTPUTS for name in task.outputs):
         values.update(_postcritical(models, res, failed, message, "fold_thrust" in task.outputs))
     data: dict[str, NDArray] = {}

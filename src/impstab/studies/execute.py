@@ -60,6 +60,7 @@ def chunk_task(study: Study, plan: ChunkPlan, index: int) -> ChunkTask:
         columns=tuple(plan.design_columns(study, index)),
         outputs=study.outputs,
         model_name=study.model_name,
+        isolation=study.isolation,
     )
 
 

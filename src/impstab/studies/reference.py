@@ -58,6 +58,24 @@ STUDY_REFERENCE: dict[str, E] = {
                     "not used by a grid."),
     "sampling.seed": E("", "Seed of the random, Sobol and Saltelli samples: the samples follow from the study file "
                        "alone."),
+    "isolation": E("", "How the isolation outputs are evaluated (peak_transmissibility, peak_frequency_hz, "
+                   "static_deflection, peak_mount_load and the named [[isolation.at]] outputs): each design is "
+                   "linearized at the isolation thrust like impstab response, all designs of a chunk solved "
+                   "together. See docs/isolation.md."),
+    "isolation.input": E("", "Dof of the unit harmonic load at A (a force on surge/sway/heave, a moment on "
+                         "roll/pitch/yaw); default: each design's excitation.input (sway)."),
+    "isolation.thrust": E("N", "Thrust of the linearization and of the static loads; default: each design's "
+                          "operating thrust, else 0."),
+    "isolation.range_hz": E("Hz", "[low, high], 0 < low < high: the range of peak_transmissibility and "
+                            "peak_frequency_hz, on a log-spaced grid of points frequencies (a grid value: a "
+                            "resonance narrower than the spacing is underestimated)."),
+    "isolation.points": E("", "Frequencies of the log-spaced grid over range_hz."),
+    "isolation.at": E("", "Named isolation outputs (at most 64), each stored as an output of its own name "
+                      "(not listed in outputs)."),
+    "isolation.at[].name": E("", "Output name: a lower-case identifier, different from every other output."),
+    "isolation.at[].frequency_hz": E("Hz", "Store the force transmissibility |F_hull| / |F_in| at this frequency."),
+    "isolation.at[].band_hz": E("Hz", "[low, high]: store the largest transmissibility over this band (64 "
+                                "log-spaced frequencies, edges included). Give frequency_hz or band_hz."),
     "execution": E("", "How the work is cut up."),
     "execution.chunk_size": E("", "Designs computed, written and resumed together (the unit of work of a Dask "
                               "worker and of resuming)."),

@@ -249,6 +249,20 @@ class StudyResult:
 
         return plot_stability_map(self, ax=ax, x=x, y=y, value=value, at=at)
 
+    def tradeoff(self, isolation: str = "peak_transmissibility", stability: str = "margin", **limits) -> dict:
+        """Isolation against stability of every design with the Pareto front
+        (:func:`impstab.studies.pareto.tradeoff_table`)."""
+        from .pareto import tradeoff_table
+
+        return tradeoff_table(self, isolation, stability, **limits)
+
+    def plot_tradeoff(self, isolation: str = "peak_transmissibility", stability: str = "margin", *, ax=None, **kw):
+        """Draw the isolation-versus-stability trade-off with the Pareto front and the requirements;
+        returns the matplotlib Axes (:func:`impstab.plot.tradeoff.plot_tradeoff`)."""
+        from ..plot.tradeoff import plot_tradeoff
+
+        return plot_tradeoff(self, isolation, stability, ax=ax, **kw)
+
     # -- exports ------------------------------------------------------------------------------
     def to_netcdf(self, path: str | os.PathLike[str], *, option: str = "path") -> Path:
         """Write the results to a netCDF file, whole or not at all (:func:`impstab.io.write_output`).

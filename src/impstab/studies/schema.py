@@ -40,10 +40,10 @@ from pydantic import (BaseModel, ConfigDict, Discriminator, Field, StrictBool, S
                       field_validator)
 
 from ..limits import MAX_TEXT
-from ..model.schema import Finite, Integer, Positive, Text, integer
+from ..model.schema import DofName, Finite, Integer, Positive, Text, integer, number
 
-__all__ = ["StudyFile", "ParameterSpec", "RangeSpec", "DistributionSpec", "OUTPUTS", "DEFAULT_OUTPUTS",
-           "POSTCRITICAL_OUTPUTS"]
+__all__ = ["StudyFile", "ParameterSpec", "RangeSpec", "DistributionSpec", "IsolationSpec", "IsolationPoint", "OUTPUTS",
+           "DEFAULT_OUTPUTS", "ISOLATION_OUTPUTS", "RESPONSE_OUTPUTS", "POSTCRITICAL_OUTPUTS"]
 
 #: every output a study can store, with its units and meaning
 OUTPUTS = {
@@ -61,9 +61,17 @@ OUTPUTS = {
                                     "normalisation, q^H q = 1 on the 12 SI states; < 0 benign, > 0 dangerous)"),
     "bifurcation": ("", "supercritical, subcritical, degenerate or none (no onset up to thrust_max)"),
     "fold_thrust": ("N", "lowest thrust of a fold of limit cycles on the computed branch (NaN: no fold)"),
+    "peak_transmissibility": ("1", "largest force transmissibility |F_hull| / |F_in| over isolation.range_hz (N/N; N/(N m) for a moment input)"),
+    "peak_frequency_hz": ("Hz", "frequency of the peak transmissibility"),
+    "static_deflection": ("m", "largest static deflection |d| of a mount at the isolation thrust"),
+    "peak_mount_load": ("N", "largest static force |F| of a mount on the hull at the isolation thrust"),
 }
 #: outputs that need the post-critical analysis of each design (impstab.postcritical)
 POSTCRITICAL_OUTPUTS = ("lyapunov_coefficient", "bifurcation", "fold_thrust")
+#: the outputs computed by the isolation evaluation (beside the named [[isolation.at]] outputs)
+ISOLATION_OUTPUTS = ("peak_transmissibility", "peak_frequency_hz", "static_deflection", "peak_mount_load")
+#: the outputs that need the forced response (a frequency grid)
+RESPONSE_OUTPUTS = ("peak_transmissibility", "peak_frequency_hz")
 DEFAULT_OUTPUTS = ("critical_thrust", "kind", "frequency_hz", "margin", "undamped_critical_thrust")
 
 #: one value of a list of values: checked against the rule of its parameter's field later
@@ -128,6 +136,29 @@ class ExecutionSpec(_Strict):
     chunk_size: integer(1, 1_000_000, "designs per chunk") = 1024  # type: ignore[valid-type]
 
 
+Frequency = number("frequency")
+#: an output name: a lower-case identifier
+OutputName = Annotated[StrictStr, Field(pattern=r"^[a-z][a-z0-9_]{0,62}$")]
+
+
+class IsolationPoint(_Strict):
+    """A named isolation output: the transmissibility at one frequency, or its peak in a band."""
+
+    name: OutputName
+    frequency_hz: Optional[Frequency] = None
+    band_hz: Optional[Annotated[list[Frequency], Field(min_length=2, max_length=2)]] = None
+
+
+class IsolationSpec(_Strict):
+    """How the isolation outputs of every design are evaluated."""
+
+    input: Optional[DofName] = None
+    thrust: Optional[number("thrust_or_zero")] = None  # type: ignore[valid-type]
+    range_hz: Optional[Annotated[list[Frequency], Field(min_length=2, max_length=2)]] = None
+    points: integer(2, 100_000, "frequencies of the isolation grid") = 400  # type: ignore[valid-type]
+    at: Annotated[list[IsolationPoint], Field(max_length=64)] = []
+
+
 class StudyFile(_Strict):
     """The whole study file."""
 
@@ -138,6 +169,7 @@ class StudyFile(_Strict):
     parameters: Annotated[list[ParameterSpec], Field(min_length=1, max_length=32)]
     sampling: SamplingSpec = SamplingSpec()
     execution: ExecutionSpec = ExecutionSpec()
+    isolation: Optional[IsolationSpec] = None
 
     @field_validator("schema_version")
     @classmethod

@@ -51,7 +51,7 @@ def data_key(name: str, plan: ChunkPlan, index: int) -> str:
     return f"{name}/c/" + "/".join(str(int(p)) for p in pos)
 
 
-def _variable_attrs(name: str) -> dict[str, Any]:
+def _variable_attrs(name: str, study: Study | None = None) -> dict[str, Any]:
     if name == "status":
         return {
             "long_name": "status of the design",
@@ -61,7 +61,7 @@ def _variable_attrs(name: str) -> dict[str, Any]:
         }
     if name == "message":
         return {"long_name": "why the design failed (empty when status is ok)"}
-    units, text = OUTPUTS[name]
+    units, text = OUTPUTS[name] if study is None else study.output_info(name)
     attrs: dict[str, Any] = {"long_name": text}
     if units:
         attrs["units"] = units
@@ -153,7 +153,7 @@ def reference_files(study: Study, plan: ChunkPlan) -> tuple[dict[str, bytes], di
     for name in arrays:
         dtype, fill = _kind(name)
         group.create_array(name, shape=study.shape, dtype=dtype, chunks=plan.chunks, fill_value=fill,
-                           dimension_names=dims, attributes=_variable_attrs(name))
+                           dimension_names=dims, attributes=_variable_attrs(name, study))
     coordinate_files = {k: list(file_checksum(v.to_bytes())) for k, v in store_dict.items()
                         if k.split("/")[0] in coords and not k.endswith("zarr.json")}
     cols = columns(arrays)

@@ -25,6 +25,7 @@ from ..limits import MAX_STUDY_BYTES
 from ..model.assemble import _error_loc, check_nesting, format_location, model_from_dict, parse_toml, read_text, rule_text
 from ..model.schema import mark_at
 from ..model.schema_doc import unknown_key_rule
+from .isolation import IsolationSettings, isolation_output_info, settings_from_spec
 from .paths import ParameterPath, resolve_path
 from .reference import DOC_PATH as STUDY_DOC_PATH
 from .sampling import axis_values, check_distribution, map_samples, unit_samples
@@ -83,6 +84,13 @@ class Study:
     source: str | None = None
     model_source: str | None = None
     seed: int = 0
+    isolation: IsolationSettings | None = None
+
+    def output_info(self, name: str) -> tuple[str, str]:
+        """``(units, description)`` of an output of this study."""
+        from .schema import OUTPUTS
+
+        return OUTPUTS.get(name) or isolation_output_info(self.isolation, name) or ("", name)
 
     def __repr__(self) -> str:
         from ..display import study_definition_text
@@ -276,12 +284,14 @@ def study_from_dict(
         size = design_count(method, doc.sampling.n, len(paths))
     if size > MAX_DESIGNS:
         raise ModelError("parameters", f"{size} designs", f"more than {MAX_DESIGNS} designs in one study")
-    needed = result_bytes(size, len(paths), doc.outputs, method == "grid")
+    isolation = settings_from_spec(doc.isolation, tuple(doc.outputs))
+    outputs = tuple(doc.outputs) + (() if isolation is None else tuple(p.name for p in isolation.at))
+    needed = result_bytes(size, len(paths), outputs, method == "grid")
     if needed > MAX_STUDY_BYTES:
         where = "sampling.n" if method != "grid" else "parameters"
         raise ModelError(
             where, f"{size} designs",
-            f"the results of {size} designs with {len(doc.outputs)} outputs would take about "
+            f"the results of {size} designs with {len(outputs)} outputs would take about "
             f"{needed / 1024**3:.3g} GiB (limit {MAX_STUDY_BYTES / 1024**3:g} GiB): fewer designs or outputs",
         )
     if method != "grid":
@@ -292,7 +302,7 @@ def study_from_dict(
         name=doc.name or (Path(source).stem if source else "study"),
         method=method,
         parameters=tuple(Parameter(p, c) for p, c in zip(paths, columns)),
-        outputs=tuple(doc.outputs),
+        outputs=outputs,
         chunk_size=doc.execution.chunk_size,
         base_model=base,
         model_name=model.name,
@@ -302,6 +312,7 @@ def study_from_dict(
         source=source,
         model_source=str(model_path),
         seed=doc.sampling.seed,
+        isolation=isolation,
     )
 
 

@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...model.model import DOF_NAMES, Model
-from ..critical_thrust import PARTICIPATION_THRESHOLD, _modes
+from ..critical_thrust import PARTICIPATION_THRESHOLD, _body_part, _modes
 from ..engine import Problem, StackOutcome, second_order_problem, solve, solve_affine
 from ..engine.problems import mass_solve
 from ..linearize import ModelFamily
@@ -156,7 +156,7 @@ def critical_thrust_batch(
         status[i], message[i] = 0, "; ".join(warn)
         out["thrust"][i] = np.nan if p is None else p
         out["omega"][i] = np.nan if omega is None else omega
-        kind[i], modes[i] = KINDS.index(k), ",".join(_modes(part))
+        kind[i], modes[i] = KINDS.index(k), ",".join(_modes(_body_part(None, part)[1]))
         up, uk = (p, k) if und is None else und
         out["undamped"][i], ukind[i] = (np.nan if up is None else up), KINDS.index(uk)
     evaluations = sum(r.evaluations for r in outcomes) + affine_evaluations

@@ -265,7 +265,10 @@ def _solve_large(problem: Problem, chunk: int) -> tuple[Outcome | None, str]:
             return None, f"the onsets with {m} and {m2} modes disagree"
         m = m2
     width = max(10 * abs(small.load - big.load) / abs(big.load), 1e-8)
-    onset, reason = large.full_onset(problem, big.load, big.kind, big.omega, w, phi, width)
+    try:
+        onset, reason = large.full_onset(problem, big.load, big.kind, big.omega, w, phi, width)
+    except np.linalg.LinAlgError as exc:  # a singular projected matrix in the subspace iteration
+        return None, f"the shift-invert subspace iteration failed ({exc})"
     if onset is None:
         return None, reason
     p, kind, omega, mode, part = onset

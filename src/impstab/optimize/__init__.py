@@ -1,0 +1,1 @@
+"""Design optimisation: population search, polish, OPT files."""
