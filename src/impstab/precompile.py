@@ -141,6 +141,9 @@ def cases(folder: Path) -> list[tuple[str, list[str]]]:
                                               "--excitation", "--json"]))
     out.append(("response lumped hull", ["response", str(_with_lumped_hull(folder, models["symmetric"])),
                                          "--frequencies", "1:40:16", "--json"]))
+    for name in ("hardening", "softening"):
+        if name in models:
+            out.append((f"postcritical {name}", ["postcritical", str(models[name]), "--max-points", "3", "--json"]))
     for name, path in _studies(folder, models).items():
         out.append((f"sweep {name}", ["sweep", str(path), "-o", str(folder / f"{path.stem}.zarr"), "--no-progress"]))
     return out

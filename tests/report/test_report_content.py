@@ -58,18 +58,17 @@ def _number(text: str) -> float:
 
 
 # ------------------------------------------------------------------ the model report
-def test_a_model_report_has_every_section_and_says_why_one_is_missing(iso):
+def test_a_model_report_has_every_section(iso):
     rep, _, path = iso
     assert [s.name for s in rep.sections] == list(SECTION_NAMES["model"])
     status = {s.name: s.status for s in rep.sections}
-    assert status.pop("postcritical") == "not computed"
     assert set(status.values()) == {"computed"}, status
-    assert "propulsor" in rep.section("postcritical").reason
     html = path.read_text(encoding="utf-8")
     assert html == rep.html
     assert parse(html).sections == {s.name: s.status for s in rep.sections}
     text = page_text(html)
-    assert "Not computed: impstab.postcritical offers no post-critical analysis" in text
+    # the isolation example's onset is a collision of two pairs: degenerate, with the reason
+    assert "Post-critical behaviour" in text and "collision on the imaginary axis" in text
 
 
 def test_the_page_is_self_contained(iso):
@@ -98,7 +97,7 @@ def test_the_page_is_self_contained(iso):
 def test_every_figure_and_table_is_in_the_page_and_not_empty(iso):
     rep, _, _ = iso
     svgs = re.findall(r"<svg\b.*?</svg>", rep.html, re.S)
-    assert len(svgs) == rep.figures == 4
+    assert len(svgs) == rep.figures == 5       # with the post-critical diagram
     for svg in svgs:
         assert len(re.findall(r"<path\b", svg)) > 20 and "<text" in svg
     tables = re.findall(r"<table\b.*?</table>", rep.html, re.S)
@@ -231,7 +230,7 @@ def test_user_strings_are_escaped_everywhere(evil):
     assert [s.name for s in rep.sections if s.status == "failed"] == []
     # the figures carry the name as text, escaped, and the dollar signs as they are (no mathtext)
     svgs = re.findall(r"<svg\b.*?</svg>", html, re.S)
-    assert len(svgs) == 3
+    assert len(svgs) == 4                        # with the post-critical diagram
     titled = [s for s in svgs if "&lt;script&gt;" in s]
     assert len(titled) >= 2 and all("$x^2$" in s for s in titled)
 
@@ -395,7 +394,7 @@ def test_statistics_hook_on_a_sampled_study(tmp_path, monkeypatch):
 def test_report_object(iso, tmp_path):
     rep, _, _ = iso
     assert re.match(r"Report\('isolated three-mount IMP: stability report': model report, 9 sections "
-                    r"\(8 computed, 1 not computed\), 4 figures, \d+ tables, \d+ kB\)", repr(rep))
+                    r"\(9 computed\), 5 figures, \d+ tables, \d+ kB\)", repr(rep))
     frame = rep._repr_html_()
     assert frame.startswith('<iframe title="isolated three-mount IMP: stability report" sandbox=""')
     assert "<svg" not in frame and "&lt;svg" in frame

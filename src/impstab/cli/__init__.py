@@ -29,6 +29,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "critical": ("core", "Critical thrust, kind, frequency and margin."),
     "added-mass": ("added_mass", "Added mass, added inertia and radiation resistance of a cylinder segment in a baffle."),
     "simulate": ("simulate", "Nonlinear time histories of MODEL_FILE from the static equilibrium under thrust."),
+    "postcritical": ("postcritical", "Hopf analysis at the onset and the branch of limit cycles past it."),
     "response": ("response", "Forced response and force transmissibility |F_hull| / |F_in| to the hull."),
     "sweep": ("sweep", "Run the design study STUDY_FILE (or resume it) into a zarr store."),
     "optimize": ("optimize", "Search the design variables of OPT_FILE for the best isolation that meets its constraints."),

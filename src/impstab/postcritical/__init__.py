@@ -12,7 +12,9 @@ matrix ``B``):
   an adaptive mesh, pseudo-arclength continuation through folds, Floquet multipliers, folds,
   period doublings and torus points located, cycles at requested parameter values;
 * :func:`find_cycle`, :func:`cycle_at`, :func:`cycles_at`: single cycles;
-* :mod:`.derivatives`: exact Jacobians (complex step) and multilinear forms (Cauchy circle).
+* :mod:`.derivatives`: exact Jacobians (complex step) and multilinear forms (Cauchy circle);
+* :func:`propulsor_postcritical` -> :class:`PostcriticalResult`: the same machinery on a
+  propulsor model's nonlinear equations of motion, with the thrust as the parameter.
 """
 
 from .collocation import Profile
@@ -20,8 +22,10 @@ from .continuation import continue_cycles, cycle_at, cycles_at, find_cycle
 from .derivatives import Forms, check_derivatives, jacobians
 from .hopf import HopfPoint, hopf_analysis
 from .result import Cycle, CycleBranch, SpecialPoint
+from .propulsor import propulsor_postcritical
+from .propulsor_result import PostcriticalResult
 from .system import DynamicalSystem
 
 __all__ = ["DynamicalSystem", "HopfPoint", "hopf_analysis", "continue_cycles", "find_cycle", "cycle_at",
            "cycles_at", "Cycle", "CycleBranch", "SpecialPoint", "Profile", "Forms", "jacobians",
-           "check_derivatives"]
+           "check_derivatives", "propulsor_postcritical", "PostcriticalResult"]

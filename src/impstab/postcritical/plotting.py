@@ -54,12 +54,14 @@ def plot_branch(branch, ax=None, state=None, operating=None):
         k = e + 1
     if hopf is not None:
         ax.plot([hopf.parameter], [0.0], "o", color="k", ms=6, zorder=5, clip_on=False,
-                label=f"Hopf point ({hopf.bifurcation}), {branch.parameter_name} = {_fmt(hopf.parameter, pscale)}")
+                label=f"Hopf point ({hopf.bifurcation}), {branch.parameter_name} = {_fmt(hopf.parameter, pscale)}"
+                      f"{' ' + branch.parameter_units if branch.parameter_units else ''}")
     seen = set()
     for sp in branch.special_points:
         mk, col, name = _MARKERS[sp.kind]
         ax.plot([sp.parameter], [sp.cycle.amplitude[j]], mk, color=col, ms=7, zorder=6, clip_on=False,
-                label=None if sp.kind in seen else f"{name}, {branch.parameter_name} = {_fmt(sp.parameter, pscale)}")
+                label=None if sp.kind in seen else f"{name}, {branch.parameter_name} = {_fmt(sp.parameter, pscale)}"
+                                                   f"{' ' + branch.parameter_units if branch.parameter_units else ''}")
         seen.add(sp.kind)
     if operating is not None:
         ax.axvline(operating, color="0.35", ls=":", lw=1.0, label=f"operating {operating:.6g}")

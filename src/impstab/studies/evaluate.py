@@ -22,7 +22,7 @@ from ..model.assemble import model_from_dict
 from .bulk import assemble_bulk
 from .isolation import IsolationSettings, isolation_outputs
 from .paths import variant_dict
-from .schema import ISOLATION_OUTPUTS
+from .schema import ISOLATION_OUTPUTS, POSTCRITICAL_OUTPUTS
 
 __all__ = ["ChunkTask", "ChunkResult", "evaluate_chunk", "variant_dict", "CODE_OUTPUTS"]
 
@@ -151,9 +151,13 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
                 status[j] = STATUSES.index("numerical_failure")
                 message[j] = text
         failed = status != 0
+    if any(name in POSTCRITICAL_OUTPUTS for name in task.outputs):
+        values.update(_postcritical(models, res, failed, message, "fold_thrust" in task.outputs))
     data: dict[str, NDArray] = {}
     for name in task.outputs:
-        if name == "modes":
+        if name == "bifurcation":
+            arr = np.array(["" if failed[j] else values[name][j] for j in range(n)], dtype=np.str_)
+        elif name == "modes":
             arr = np.array(["" if failed[j] else res.modes[j] for j in range(n)], dtype=np.str_)
         elif name in CODE_OUTPUTS:
             arr = np.where(failed, -1, values[name]).astype(np.int8)
@@ -163,3 +167,41 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
     data["status"] = status.astype(np.int8).reshape(task.block)
     data["message"] = np.array(message, dtype=np.str_).reshape(task.block)
     return ChunkResult(task.index, data, time.perf_counter() - t0, res.evaluations)
+
+
+def _postcritical(models, res, failed, message, branch: bool) -> dict[str, object]:
+    """``lyapunov_coefficient``, ``bifurcation`` and ``fold_thrust`` of each design, by the
+    post-critical analysis (:func:`impstab.postcritical.propulsor_postcritical`) from the onset the
+    batch found: the Hopf analysis (a fraction of a second per design), and with ``branch`` the
+    branch of cycles for the fold (seconds per design). A design whose analysis fails keeps its
+    linear results; the message says why."""
+    from types import SimpleNamespace
+
+    from ..errors import NumericalError
+    from ..linear.batch import KINDS
+    from ..postcritical import propulsor_postcritical
+
+    n = len(models)
+    l1 = np.full(n, np.nan)
+    fold = np.full(n, np.nan)
+    label = [""] * n
+    for j, model in enumerate(models):
+        if failed[j] or model is None:
+            continue
+        kind = KINDS[int(res.kind[j])]
+        if kind == "none":
+            label[j] = "none"
+            continue
+        onset = SimpleNamespace(thrust=float(res.thrust[j]), kind=kind, omega=float(res.omega[j]),
+                                linearization=model.analysis.linearization)
+        try:
+            pc = propulsor_postcritical(model, thrust_max=float(res.thrust_max[j]), critical=onset, branch=branch,
+                                        max_points=40)
+        except (NumericalError, ModelError, np.linalg.LinAlgError) as exc:
+            message[j] = f"postcritical: {exc}"
+            continue
+        label[j] = pc.bifurcation or "none"
+        l1[j] = np.nan if pc.lyapunov_coefficient is None else pc.lyapunov_coefficient
+        fold[j] = np.nan if pc.fold_thrust is None else pc.fold_thrust
+    return {"lyapunov_coefficient": l1, "bifurcation": label, "fold_thrust": fold}
+

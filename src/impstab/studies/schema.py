@@ -43,7 +43,7 @@ from ..limits import MAX_TEXT
 from ..model.schema import DofName, Finite, Integer, Positive, Text, integer, number
 
 __all__ = ["StudyFile", "ParameterSpec", "RangeSpec", "DistributionSpec", "IsolationSpec", "IsolationPoint", "OUTPUTS",
-           "DEFAULT_OUTPUTS", "ISOLATION_OUTPUTS", "RESPONSE_OUTPUTS"]
+           "DEFAULT_OUTPUTS", "ISOLATION_OUTPUTS", "RESPONSE_OUTPUTS", "POSTCRITICAL_OUTPUTS"]
 
 #: every output a study can store, with its units and meaning
 OUTPUTS = {
@@ -57,11 +57,17 @@ OUTPUTS = {
     "modes": ("", "dofs with at least 5 % of the kinetic energy of the critical mode"),
     "thrust_max": ("N", "upper end of the critical-thrust search"),
     "operating_thrust": ("N", "operating thrust"),
+    "lyapunov_coefficient": ("1/s", "first Lyapunov coefficient l1 of the Hopf point at the onset (Kuznetsov's "
+                                    "normalisation, q^H q = 1 on the 12 SI states; < 0 benign, > 0 dangerous)"),
+    "bifurcation": ("", "supercritical, subcritical, degenerate or none (no onset up to thrust_max)"),
+    "fold_thrust": ("N", "lowest thrust of a fold of limit cycles on the computed branch (NaN: no fold)"),
     "peak_transmissibility": ("1", "largest force transmissibility |F_hull| / |F_in| over isolation.range_hz (N/N; N/(N m) for a moment input)"),
     "peak_frequency_hz": ("Hz", "frequency of the peak transmissibility"),
     "static_deflection": ("m", "largest static deflection |d| of a mount at the isolation thrust"),
     "peak_mount_load": ("N", "largest static force |F| of a mount on the hull at the isolation thrust"),
 }
+#: outputs that need the post-critical analysis of each design (impstab.postcritical)
+POSTCRITICAL_OUTPUTS = ("lyapunov_coefficient", "bifurcation", "fold_thrust")
 #: the outputs computed by the isolation evaluation (beside the named [[isolation.at]] outputs)
 ISOLATION_OUTPUTS = ("peak_transmissibility", "peak_frequency_hz", "static_deflection", "peak_mount_load")
 #: the outputs that need the forced response (a frequency grid)

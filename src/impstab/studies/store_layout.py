@@ -72,7 +72,7 @@ def _variable_attrs(name: str, study: Study | None = None) -> dict[str, Any]:
 
 
 def _kind(name: str) -> tuple[Any, Any]:
-    if name in ("message", "modes"):
+    if name in ("message", "modes", "bifurcation"):
         return str, ""
     if name == "status" or name in CODE_OUTPUTS:
         return "i1", -1

@@ -37,7 +37,7 @@ __all__ = ["Study", "Parameter", "load_study", "study_from_dict", "describe", "M
 MAX_DESIGNS = 100_000_000
 #: bytes per design of each output in memory (floats 8, kind codes 1, "modes" up to 36 characters
 #: of 4 bytes), and of the status code and the message (an object pointer) of every design
-_OUTPUT_BYTES = {"kind": 1, "undamped_kind": 1, "modes": 144}
+_OUTPUT_BYTES = {"kind": 1, "undamped_kind": 1, "modes": 144, "bifurcation": 52}
 _DESIGN_BYTES = 1 + 8
 
 
