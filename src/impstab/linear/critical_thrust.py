@@ -12,6 +12,7 @@ from ..limits import check_number
 from ..model.model import DOF_NAMES, Model
 from .critical import CriticalLoad, Crossing, critical_load_family
 from .linearize import ModelFamily
+from .practical import PracticalOnset, damping_threshold, practical_problem, practical_onset
 
 __all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD", "operating_point_warnings"]
 
@@ -52,6 +53,10 @@ class CriticalThrust:
         With compressible fluid loading: the frequency (Hz) at which the added mass and radiation
         damping were taken (consistent with the onset frequency), the number of fixed-point
         iterations, and the last relative change of the critical thrust.
+    practical : PracticalOnset or None
+        With a damping threshold (``analysis.min_damping_ratio`` or ``min_log_decrement``): the
+        first thrust at which the least-damped mode's damping ratio falls to it
+        (:mod:`impstab.linear.practical`); None without a threshold.
     """
 
     thrust: float | None
@@ -72,6 +77,7 @@ class CriticalThrust:
     fluid_iterations: int = 0
     fluid_change: float | None = None
     warnings: tuple[str, ...] = ()
+    practical: PracticalOnset | None = None
 
     def __repr__(self) -> str:
         from ..display import critical_text
@@ -94,6 +100,20 @@ class CriticalThrust:
         if self.thrust is None or not self.operating_thrust:
             return None
         return self.thrust / self.operating_thrust
+
+    @property
+    def practical_thrust(self) -> float | None:
+        """Practical critical thrust (N): the least damping ratio falls to the threshold there;
+        None without a threshold or when it is kept up to ``thrust_max``."""
+        return None if self.practical is None else self.practical.load
+
+    @property
+    def practical_margin(self) -> float | None:
+        """``practical critical / operating`` (None without either)."""
+        p = self.practical_thrust
+        if p is None or not self.operating_thrust:
+            return None
+        return p / self.operating_thrust
 
     def to_dict(self) -> dict:
         """The JSON object of ``impstab critical --json`` (DESIGN.md), plus extra keys."""
@@ -118,8 +138,20 @@ class CriticalThrust:
             "fluid_iterations": self.fluid_iterations,
             "fluid_change": self.fluid_change,
             "warnings": list(self.warnings),
+            **self._practical_dict(),
             "model": self.model_name,
             "impstab_version": __version__,
+        }
+
+    def _practical_dict(self) -> dict:
+        p = self.practical
+        return {
+            "practical_critical_thrust": self.practical_thrust,
+            "practical_margin": self.practical_margin,
+            "practical_kind": None if p is None else p.kind,
+            "practical_frequency_hz": None if p is None else p.frequency_hz,
+            "min_damping_ratio": None if p is None else p.damping_ratio,
+            "min_log_decrement": None if p is None else p.log_decrement,
         }
 
     def to_json(self) -> str:
@@ -155,6 +187,8 @@ def critical_thrust(
     linearization: str | None = None,
     n_scan: int = 64,
     all_crossings: bool = False,
+    min_damping_ratio: float | None = None,
+    min_log_decrement: float | None = None,
 ) -> CriticalThrust:
     """First loss of stability of ``model`` as the thrust grows from 0 to ``thrust_max``.
 
@@ -169,6 +203,11 @@ def critical_thrust(
         Scan intervals before refinement (the refinement is exact; the scan only brackets).
     all_crossings : bool
         Also list every later loss and gain of stability (restabilisation) up to ``thrust_max``.
+    min_damping_ratio, min_log_decrement : float, optional
+        A damping threshold (one of the two; default the model's ``analysis`` keys): also find the
+        practical critical thrust, the first thrust at which the least damping ratio
+        ``-Re lambda / |lambda|`` falls to ``min_damping_ratio``, or the least logarithmic decrement
+        ``-2 pi Re lambda / Im lambda`` to ``min_log_decrement`` (API 617 / 684 use 0.1).
 
     Returns
     -------
@@ -198,6 +237,11 @@ def critical_thrust(
     else:
         und = res
     notes = operating_point_warnings(res.load, model.thrust.operating, t_max)
+    if min_damping_ratio is None and min_log_decrement is None:
+        zeta = model.analysis.min_damping_ratio
+    else:
+        zeta = damping_threshold(min_damping_ratio, min_log_decrement)
+    practical = None if zeta is None else _practical(model, linearization, t_max, zeta, n_scan, f_fluid)
     return CriticalThrust(
         thrust=res.load,
         kind=res.kind,
@@ -216,5 +260,30 @@ def critical_thrust(
         fluid_frequency_hz=f_fluid if model.fluid.compressible else None,
         fluid_iterations=iterations,
         fluid_change=change,
-        warnings=notes + tuple(res.warnings) + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
+        warnings=notes + tuple(res.warnings) + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res)
+        + (() if practical is None else tuple(f"practical onset: {w}" for w in practical.warnings)),
+        practical=practical,
     )
+
+
+def _practical(model: Model, linearization: str | None, t_max: float, zeta: float, n_scan: int,
+               f_fluid: float) -> PracticalOnset:
+    """The practical onset (compressible fluid: coefficients at its own frequency, iterated)."""
+    from .engine import solve
+
+    def at(frequency: float) -> PracticalOnset:
+        base, turned = practical_problem(ModelFamily(model, linearization, fluid_frequency=frequency), t_max, zeta,
+                                         n_scan=n_scan)
+        return practical_onset(base, solve([turned])[0], zeta)
+
+    onset = at(f_fluid)
+    if model.fluid.compressible:
+        for _ in range(FLUID_MAX_ITERATIONS):
+            if onset.load is None or not onset.omega:
+                break
+            new = at(onset.omega / (2 * np.pi))
+            change = None if new.load is None or not new.load else abs(new.load - onset.load) / new.load
+            onset = new
+            if change is not None and change <= FLUID_TOLERANCE:
+                break
+    return onset
