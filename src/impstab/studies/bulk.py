@@ -114,7 +114,7 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
         return None
     if model.is_damped or model.fluid.compressible or model.propeller.polar_inertia * model.propeller.speed != 0.0:
         return None
-    if model.is_nonlinear:
+    if model.is_nonlinear or model.analysis.min_damping_ratio is not None:  # the practical onset: per model
         return None
     for seg in segments:
         if seg[0] == "mounts" and seg[2] in ("k_axial", "k_shear") and doc.mounts[seg[1]].stiffness is not None:
