@@ -158,6 +158,8 @@ RANGES: dict[str, Range] = {
     "thrust": Range(1e-3, 1e9, "N", "a thrust"),
     "thrust_or_zero": Range(0.0, 1e9, "N", "a thrust"),
     "fraction": Range(0.0, 1.0, "", "a fraction"),
+    "damping_ratio": Range(0.0, 0.9, "", "a damping-ratio threshold"),
+    "log_decrement": Range(0.0, 12.0, "", "a logarithmic-decrement threshold"),
     "spin_speed": Range(-1e5, 1e5, "rad/s", "a propeller speed"),
     "spin_speed_rpm": Range(-1e6, 1e6, "rpm", "a propeller speed"),
     "density": Range(1e-3, 1e5, "kg/m^3", "a fluid density"),

@@ -211,9 +211,9 @@ def at_thrust(option: str, thrust: float, model, compute):
         except (NumericalError, ModelError):
             raise exc from None
         if crit.thrust is not None and thrust >= crit.thrust:
-            raise ModelError(option, thrust, f"no static equilibrium found at this thrust: the model loses stability "
-                                             f"at {crit.thrust:.6g} N ({crit.kind}) and its mounts do not carry "
-                                             "this thrust") from None
+            reason = getattr(exc, "reason", "its mounts do not carry this thrust")
+            raise ModelError(option, thrust, f"no static equilibrium found at this thrust: {reason}; the model "
+                                             f"loses stability at {crit.thrust:.6g} N ({crit.kind})") from None
         raise
 
 

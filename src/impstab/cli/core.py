@@ -262,13 +262,21 @@ def locus_cmd(model_file: str, thrust_max: float | None, steps: int, linearizati
 @click.option("--thrust-max", type=float, default=None, help="override analysis.thrust_max (N)")
 @click.option("--linearization", type=LINEARIZATION, default=None)
 @click.option("--all-crossings", is_flag=True, help="also list later losses and gains of stability")
-def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linearization: str | None, all_crossings: bool) -> None:
+@click.option("--min-damping-ratio", type=float, default=None,
+              help="practical criterion: override analysis.min_damping_ratio (1)")
+@click.option("--min-log-decrement", type=float, default=None,
+              help="practical criterion: override analysis.min_log_decrement (1; API 617/684: 0.1)")
+def critical_cmd(model_file: str, as_json: bool, thrust_max: float | None, linearization: str | None, all_crossings: bool,
+                 min_damping_ratio: float | None, min_log_decrement: float | None) -> None:
     """Critical thrust, kind, frequency and margin."""
     from ..linear.critical_thrust import critical_thrust
+    from ..model.criteria import damping_threshold
 
     thrust_max = check_number("--thrust-max", thrust_max, kind="thrust")
+    zeta = damping_threshold(min_damping_ratio, min_log_decrement, names=("--min-damping-ratio", "--min-log-decrement"))
     model = _load(model_file)
-    res = critical_thrust(model, thrust_max=thrust_max, linearization=linearization, all_crossings=all_crossings)
+    res = critical_thrust(model, thrust_max=thrust_max, linearization=linearization, all_crossings=all_crossings,
+                          min_damping_ratio=zeta)
     if as_json:
         print_json(res.to_dict())
         return

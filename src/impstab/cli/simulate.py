@@ -11,7 +11,7 @@ import click
 
 from ..display.format import growth
 from ..errors import ModelError, printable
-from ..limits import LONG_FACTOR, MAX_OUTPUT_BYTES, MAX_STEPS, MAX_THRUSTS, describe_count
+from ..limits import LONG_FACTOR, MAX_STEPS, MAX_THRUSTS
 from ._common import (at_thrust, check_number, console, data_and_figure, draw_and_save, figure_options, fmt, print_json,
                       table, user_text)
 
@@ -54,33 +54,6 @@ def _dof_values(option: str, items: tuple[str, ...]) -> dict[str, float]:
             raise ModelError(option, item, "must be DOF=VALUE with a number VALUE") from None
         out[name] = check_number(option, v, kind="displacement" if option == "--displace" else "velocity")
     return out
-
-
-def _check_work(model, step_sizes: list[float], duration: float, dt: float | None, sample: float | None,
-                allow_long: bool) -> None:
-    """Refuse a simulation whose time steps or stored samples exceed the limits, before it runs.
-
-    ``step_sizes`` holds each run's step (s). The samples of a run are every step, at most
-    :data:`~impstab.dynamics.simulate.MAX_SAMPLES` of them, unless ``--sample`` is given; each
-    takes 8 bytes for the time, the 12 states, the thrust, the error estimate and the 6 loads of
-    every mount, twice (the run and the file written from it).
-    """
-    from ..dynamics.simulate import MAX_SAMPLES
-
-    limit = MAX_STEPS * (LONG_FACTOR if allow_long else 1)
-    total = sum(duration / h for h in step_sizes)
-    option = "--dt" if dt is not None else "--duration"
-    if total > limit:
-        hint = "" if allow_long else f"; --allow-long runs up to {describe_count(limit * LONG_FACTOR)} with a progress bar"
-        raise ModelError(option, dt if dt is not None else duration,
-                         f"would need {describe_count(total)} time steps (limit {describe_count(limit)}){hint}")
-    per_sample = 8 * 2 * (15 + 6 * len(model.mounts))
-    samples = sum(math.ceil(duration / sample) if sample is not None else min(math.ceil(duration / h), MAX_SAMPLES)
-                  for h in step_sizes)
-    if samples * per_sample > MAX_OUTPUT_BYTES:
-        raise ModelError("--sample" if sample is not None else option, sample if sample is not None else duration,
-                         f"{describe_count(samples)} stored samples would take {samples * per_sample / 1024**3:.3g} GiB "
-                         f"(limit {MAX_OUTPUT_BYTES / 1024**3:g} GiB): use a longer --sample interval")
 
 
 def _progress(enabled: bool):
@@ -168,7 +141,7 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     Figures 5-6, and reports the fitted envelope growth rate beside max Re(lambda) of the
     linearized system and the sub/at/supercritical classification.
     """
-    from ..dynamics.simulate import default_step, simulate
+    from ..dynamics.simulate import CLI_NAMES, check_work, default_step, simulate
     from ..linear.critical_thrust import critical_thrust
     from ..model import load_model
 
@@ -195,7 +168,7 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
         dt = min(steps.values())
     if len(values) > 1 and sample is None:
         sample = dt * max(1, math.ceil(duration / dt / 100_000))
-    _check_work(model, [dt or steps[v] for v in values], duration, dt, sample, allow_long)
+    check_work(model, [dt or steps[v] for v in values], duration, dt, sample, allow_long, CLI_NAMES)
     results = []
     with _progress(sys.stderr.isatty() and not as_json) as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -203,7 +176,7 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
             task = bar.add_task(f"T = {v:.6g} N", total=1.0)
             results.append(simulate(model, thrust=v, duration=duration, integrator=integrator.lower(), dt=dt,
                                     perturbation=pert, sample=sample, tol=tol, critical_thrust=crit,
-                                    progress=lambda f, task=task: bar.update(task, completed=f)))
+                                    progress=lambda f, task=task: bar.update(task, completed=f), allow_long=allow_long))
     for w in dict.fromkeys(str(w.message) for w in caught):
         click.echo(f"impstab: warning: {printable(w)}", err=True)
     if data is not None:

@@ -204,6 +204,30 @@ def _num(x, unit: str = "", digits: int = 6, missing: str = "n/a") -> str:
     return number(x, digits, unit, missing=missing)
 
 
+def practical_rows(res) -> list[tuple[str, str]]:
+    """The rows of the practical criterion (none without a damping threshold)."""
+    p = getattr(res, "practical", None)
+    if p is None:
+        return []
+    rows = [("practical criterion", f"damping ratio >= {_num(p.damping_ratio, '', 4)} "
+                                    f"(log decr. {_num(p.log_decrement, '', 4)})")]
+    if p.load is None:
+        value = f"none up to {res.thrust_max:g} N (every mode keeps the threshold)"
+    elif p.at_start:
+        value = "0 N (the least-damped mode is below the threshold already at T = 0)"
+    else:
+        value = f"{_num(p.load, 'N', 10)} ({p.kind}, {_num(p.frequency_hz)} Hz)"
+    rows.append(("practical critical thrust", value))
+    if res.practical_margin is not None:
+        margin = _num(res.practical_margin, "", 4)
+    elif res.operating_thrust is None:
+        margin = "needs an operating thrust"
+    else:
+        margin = f"> {res.thrust_max / res.operating_thrust:.4g} (threshold kept up to thrust_max)"
+    rows.append(("practical margin", margin))
+    return rows
+
+
 def critical_rows(res, damped: bool | None = None) -> list[tuple[str, str]]:
     """The rows of the ``critical`` table: every value with its unit, every gap explained.
 
@@ -233,6 +257,7 @@ def critical_rows(res, damped: bool | None = None) -> list[tuple[str, str]]:
     else:
         und = f"{_num(res.undamped_thrust, 'N', 10)} ({res.undamped_kind})"
     rows.append(("undamped critical thrust", und))
+    rows.extend(practical_rows(res))
     rows.append(("linearization", res.linearization))
     rows.append(("search range", f"0 to {res.thrust_max:g} N"))
     return rows

@@ -20,7 +20,7 @@ from .rhs import PITCH_LIMIT
 from .system import pack_dynamics
 from .result import SimulationResult
 
-__all__ = ["simulate", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
+__all__ = ["simulate", "check_work", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
 
 #: fixed steps per period of the fastest mode of the linearized system (Hamming's method is
 #: stable on the imaginary axis only for |h omega| below about 0.3; 40 steps give 0.157)
@@ -93,12 +93,49 @@ def _spin_law(model: Model) -> Callable:
     return lambda t: np.full(np.shape(t), prop.speed)
 
 
+#: the argument names of :func:`simulate` in the messages of :func:`check_work`
+PYTHON_NAMES = {"dt": "dt", "duration": "duration", "sample": "sample", "allow_long": "allow_long=True"}
+#: the option names of ``impstab simulate``
+CLI_NAMES = {"dt": "--dt", "duration": "--duration", "sample": "--sample", "allow_long": "--allow-long"}
+
+
+def check_work(model: Model, step_sizes: list[float], duration: float, dt: float | None, sample: float | None,
+               allow_long: bool, names: dict[str, str] = PYTHON_NAMES) -> None:
+    """Refuse runs whose time steps or stored samples exceed the limits, before they start.
+
+    ``step_sizes`` holds each run's step (s). The steps of all runs together may be at most
+    :data:`~impstab.limits.MAX_STEPS` (``allow_long``: :data:`~impstab.limits.LONG_FACTOR` times
+    more). The samples of a run are every step, at most :data:`MAX_SAMPLES` of them, unless
+    ``sample`` is given; each takes 8 bytes for the time, the 12 states, the thrust, the error
+    estimate and the 6 loads of every mount, twice (the run and a file written from it); they may
+    take at most :data:`~impstab.limits.MAX_OUTPUT_BYTES`. ``names`` gives the argument names the
+    messages use (``dt``, ``duration``, ``sample``, ``allow_long``).
+    """
+    from ..limits import LONG_FACTOR, MAX_OUTPUT_BYTES, MAX_STEPS, describe_count
+
+    limit = MAX_STEPS * (LONG_FACTOR if allow_long else 1)
+    total = sum(duration / h for h in step_sizes)
+    field = names["dt"] if dt is not None else names["duration"]
+    if total > limit:
+        hint = "" if allow_long else f"; {names['allow_long']} runs up to {describe_count(limit * LONG_FACTOR)}" + (
+            " with a progress bar" if names is CLI_NAMES else "")
+        raise ModelError(field, dt if dt is not None else duration,
+                         f"would need {describe_count(total)} time steps (limit {describe_count(limit)}){hint}")
+    per_sample = 8 * 2 * (15 + 6 * len(model.mounts))
+    samples = sum(math.ceil(duration / sample) if sample is not None else min(math.ceil(duration / h), MAX_SAMPLES)
+                  for h in step_sizes)
+    if samples * per_sample > MAX_OUTPUT_BYTES:
+        raise ModelError(names["sample"] if sample is not None else field, sample if sample is not None else duration,
+                         f"{describe_count(samples)} stored samples would take {samples * per_sample / 1024**3:.3g} GiB "
+                         f"(limit {MAX_OUTPUT_BYTES / 1024**3:g} GiB): use a longer {names['sample']} interval")
+
+
 def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
              dt: float | None = None, perturbation=None, sample: float | None = None, *,
              tol: float | None = None, rtol: float = 1e-8, atol=None, pitch_limit: float = PITCH_LIMIT,
              max_displacement: float | None = None, fit_window: tuple[float, float] | None = None,
              critical_thrust: float | None | bool = True,
-             progress: Callable[[float], None] | None = None) -> SimulationResult:
+             progress: Callable[[float], None] | None = None, allow_long: bool = False) -> SimulationResult:
     """Integrate the nonlinear equations of motion from the static equilibrium under thrust.
 
     Parameters
@@ -137,6 +174,12 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
         stable up to ``thrust_max``; False skips the classification.
     progress : callable, optional
         Called with the fraction done between compiled chunks.
+    allow_long : bool
+        Allow a run beyond :data:`~impstab.limits.MAX_STEPS` time steps (up to
+        :data:`~impstab.limits.LONG_FACTOR` times more; ``impstab simulate --allow-long``). The
+        steps (``duration / dt``, the default step when ``dt`` is not given) and the memory of the
+        stored samples are estimated before the run and refused beyond the limits with a
+        :class:`~impstab.errors.ModelError` naming the argument.
 
     Returns
     -------
@@ -186,6 +229,7 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
             f"{omega / (2 * math.pi):.4g} Hz): use at least {STEPS_PER_PERIOD} steps per period, or the "
             f"integrator's own growth can look like flutter", StepSizeWarning, stacklevel=2)
     h = dt if dt is not None else h_limit
+    check_work(model, [h], duration, dt, sample, allow_long)
     if sample is None:
         steps = math.ceil(duration / h)
         sample = h * max(1, math.ceil(steps / MAX_SAMPLES))

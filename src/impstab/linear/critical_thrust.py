@@ -12,6 +12,7 @@ from ..limits import check_number
 from ..model.model import DOF_NAMES, Model
 from .critical import CriticalLoad, Crossing, critical_load_family
 from .linearize import ModelFamily
+from .practical import PracticalOnset, damping_threshold, practical_problem, practical_onset
 
 __all__ = ["CriticalThrust", "critical_thrust", "PARTICIPATION_THRESHOLD", "operating_point_warnings"]
 
@@ -52,6 +53,10 @@ class CriticalThrust:
         With compressible fluid loading: the frequency (Hz) at which the added mass and radiation
         damping were taken (consistent with the onset frequency), the number of fixed-point
         iterations, and the last relative change of the critical thrust.
+    practical : PracticalOnset or None
+        With a damping threshold (``analysis.min_damping_ratio`` or ``min_log_decrement``): the
+        first thrust at which the least-damped mode's damping ratio falls to it
+        (:mod:`impstab.linear.practical`); None without a threshold.
     """
 
     thrust: float | None
@@ -76,6 +81,7 @@ class CriticalThrust:
     #: (:func:`impstab.linear.viscoelastic.exact_onset`), and the fits of the mounts' laws
     exact_onset: object | None = None
     viscoelastic_fits: tuple[dict, ...] = ()
+    practical: PracticalOnset | None = None
 
     def __repr__(self) -> str:
         from ..display import critical_text
@@ -98,6 +104,20 @@ class CriticalThrust:
         if self.thrust is None or not self.operating_thrust:
             return None
         return self.thrust / self.operating_thrust
+
+    @property
+    def practical_thrust(self) -> float | None:
+        """Practical critical thrust (N): the least damping ratio falls to the threshold there;
+        None without a threshold or when it is kept up to ``thrust_max``."""
+        return None if self.practical is None else self.practical.load
+
+    @property
+    def practical_margin(self) -> float | None:
+        """``practical critical / operating`` (None without either)."""
+        p = self.practical_thrust
+        if p is None or not self.operating_thrust:
+            return None
+        return p / self.operating_thrust
 
     def to_dict(self) -> dict:
         """The JSON object of ``impstab critical --json`` (DESIGN.md), plus extra keys."""
@@ -127,8 +147,20 @@ class CriticalThrust:
                 "fits": list(self.viscoelastic_fits),
                 "exact_check": None if self.exact_onset is None else self.exact_onset.to_dict(),
             },
+            **self._practical_dict(),
             "model": self.model_name,
             "impstab_version": __version__,
+        }
+
+    def _practical_dict(self) -> dict:
+        p = self.practical
+        return {
+            "practical_critical_thrust": self.practical_thrust,
+            "practical_margin": self.practical_margin,
+            "practical_kind": None if p is None else p.kind,
+            "practical_frequency_hz": None if p is None else p.frequency_hz,
+            "min_damping_ratio": None if p is None else p.damping_ratio,
+            "min_log_decrement": None if p is None else p.log_decrement,
         }
 
     def to_json(self) -> str:
@@ -176,6 +208,8 @@ def critical_thrust(
     linearization: str | None = None,
     n_scan: int = 64,
     all_crossings: bool = False,
+    min_damping_ratio: float | None = None,
+    min_log_decrement: float | None = None,
 ) -> CriticalThrust:
     """First loss of stability of ``model`` as the thrust grows from 0 to ``thrust_max``.
 
@@ -190,6 +224,11 @@ def critical_thrust(
         Scan intervals before refinement (the refinement is exact; the scan only brackets).
     all_crossings : bool
         Also list every later loss and gain of stability (restabilisation) up to ``thrust_max``.
+    min_damping_ratio, min_log_decrement : float, optional
+        A damping threshold (one of the two; default the model's ``analysis`` keys): also find the
+        practical critical thrust, the first thrust at which the least damping ratio
+        ``-Re lambda / |lambda|`` falls to ``min_damping_ratio``, or the least logarithmic decrement
+        ``-2 pi Re lambda / Im lambda`` to ``min_log_decrement`` (API 617 / 684 use 0.1).
 
     Returns
     -------
@@ -223,6 +262,11 @@ def critical_thrust(
         load, omega, check, fits, visco_notes = _viscoelastic_check(model, res, fam.linearization, f_fluid, fam)
     notes = operating_point_warnings(load, model.thrust.operating, t_max)
     shape, part = _body_part(res.mode, res.participation)
+    if min_damping_ratio is None and min_log_decrement is None:
+        zeta = model.analysis.min_damping_ratio
+    else:
+        zeta = damping_threshold(min_damping_ratio, min_log_decrement)
+    practical = None if zeta is None else _practical(model, linearization, t_max, zeta, n_scan, f_fluid)
     return CriticalThrust(
         thrust=load,
         kind=res.kind,
@@ -242,9 +286,11 @@ def critical_thrust(
         fluid_iterations=iterations,
         fluid_change=change,
         warnings=notes + tuple(res.warnings) + visco_notes
-        + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res),
+        + tuple(f"undamped companion: {w}" for w in und.warnings if und is not res)
+        + (() if practical is None else tuple(f"practical onset: {w}" for w in practical.warnings)),
         exact_onset=check,
         viscoelastic_fits=fits,
+        practical=practical,
     )
 
 
@@ -294,3 +340,26 @@ def _viscoelastic_check(model: Model, res: CriticalLoad, linearization: str, f_f
                      "(fit_terms, fit_band_hz)")
         return res.load, res.omega, check, fits, tuple(notes)
     return check.exact_thrust, (check.exact_omega if res.omega else res.omega), check, fits, tuple(notes)
+
+
+def _practical(model: Model, linearization: str | None, t_max: float, zeta: float, n_scan: int,
+               f_fluid: float) -> PracticalOnset:
+    """The practical onset (compressible fluid: coefficients at its own frequency, iterated)."""
+    from .engine import solve
+
+    def at(frequency: float) -> PracticalOnset:
+        base, turned = practical_problem(_family(model, linearization, frequency), t_max, zeta,
+                                         n_scan=n_scan)
+        return practical_onset(base, solve([turned])[0], zeta)
+
+    onset = at(f_fluid)
+    if model.fluid.compressible:
+        for _ in range(FLUID_MAX_ITERATIONS):
+            if onset.load is None or not onset.omega:
+                break
+            new = at(onset.omega / (2 * np.pi))
+            change = None if new.load is None or not new.load else abs(new.load - onset.load) / new.load
+            onset = new
+            if change is not None and change <= FLUID_TOLERANCE:
+                break
+    return onset

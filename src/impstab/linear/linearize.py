@@ -139,6 +139,27 @@ def affine_forms(
     return m, d, k0, k1, g, affine
 
 
+def lost_equilibrium_reason(model: Model, thrust: float, length_scale: float) -> str:
+    """Why the static equilibrium could not be followed to ``thrust`` (N), in words.
+
+    Linear statics ``K_c q = (T e, T r x e)`` tells the two cases apart: a deflection of many
+    times the model's size (very soft mounts under a large thrust; the continuation's load steps
+    stop at :data:`~impstab.linear.tangent.MAX_PREDICTOR` of the length scale, 1024 of them) or
+    a limit point of the nonlinear path (the mounts do not carry the thrust).
+    """
+    e = np.asarray(model.thrust.direction, dtype=float)
+    load = thrust * np.concatenate([e, np.cross(np.asarray(model.thrust.point, dtype=float), e)])
+    try:
+        q = np.linalg.solve(model.elastic_stiffness, load)
+    except np.linalg.LinAlgError:
+        return "the mounts give no stiffness against this thrust"
+    size = float(np.abs(q[:3]).max() + length_scale * np.abs(q[3:]).max())
+    if np.isfinite(size) and size > length_scale:
+        return (f"linear statics deflects the mounts by {size:.3g} m under it, {size / length_scale:.3g} times the "
+                f"model's size ({length_scale:.3g} m), beyond what the equilibrium path is followed to")
+    return "the mounts cannot carry this thrust (a limit point of the static path)"
+
+
 @dataclass(frozen=True, eq=False)
 class ModelFamily:
     """The model's linearized systems as a function of thrust, evaluated in batches.
@@ -230,11 +251,14 @@ class ModelFamily:
         self._remember(thrusts[ok], u0[ok], r0[ok])
         if not ok.all():
             if strict:
-                bad = thrusts[~ok][0]
-                raise NumericalError(
+                bad = float(thrusts[~ok][0])
+                reason = lost_equilibrium_reason(self.model, bad, pk.length_scale)
+                err = NumericalError(
                     f"no static equilibrium found at thrust {bad:.6g} N (Newton with load stepping "
-                    "did not converge): the mounts cannot carry this thrust"
+                    f"did not converge): {reason}"
                 )
+                err.reason = reason  # type: ignore[attr-defined]
+                raise err
             for a in (m, d, g, k):
                 a[~ok] = np.nan
         return m, d, g, k, u0, r0

@@ -262,19 +262,45 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
 
 
 def _fluid_consistent(model: Model, thrust: float, linearization: str | None, base: ModalResult) -> ModalResult:
+    """Each mode with the fluid coefficients at its own frequency (fixed point on the frequency).
+
+    Modes that converge to one frequency share one eigenproblem there: each takes a different
+    eigenvalue of it (the nearest not taken yet), so a repeated eigenvalue is listed as often as
+    its multiplicity, with independent shapes, never one mode twice.
+    """
     from .linearize import ModelFamily
 
-    vals, shapes, part = base.eigenvalues.copy(), base.shapes.copy(), base.participation.copy()
-    for j in range(len(vals)):
-        f = abs(vals[j].imag) / (2 * np.pi)
-        for _ in range(50):
+    solved: dict[float, ModalResult] = {}
+
+    def at(f: float) -> ModalResult:
+        if f not in solved:
             fam = ModelFamily(model, linearization, fluid_frequency=f)
             m, d, g, k, u0, r0 = fam.evaluate(np.array([thrust]))
-            res = modes_of_system(LinearSystem(m[0], d[0], g[0], k[0], thrust, fam.linearization, u0[0], r0[0]))
-            i = int(np.argmin(np.abs(res.eigenvalues - vals[j])))
-            vals[j], shapes[:, j], part[j] = res.eigenvalues[i], res.shapes[:, i], res.participation[i]
-            f_new = abs(vals[j].imag) / (2 * np.pi)
-            if abs(f_new - f) <= 1e-12 * max(f_new, 1e-300):
+            solved[f] = modes_of_system(LinearSystem(m[0], d[0], g[0], k[0], thrust, fam.linearization, u0[0], r0[0]))
+        return solved[f]
+
+    taken: dict[float, set[int]] = {}
+    n = len(base.eigenvalues)
+    vals, shapes, part = base.eigenvalues.copy(), base.shapes.copy(), base.participation.copy()
+    for j in range(n):
+        target, f = vals[j], abs(vals[j].imag) / (2 * np.pi)
+        for _ in range(50):
+            f = next((h for h in taken if abs(h - f) <= FREQUENCY_TOLERANCE * max(h, 1e-300)), f)
+            res = at(f)
+            dist = np.abs(res.eigenvalues - target)
+            dist[list(taken.get(f, ()))] = np.inf
+            i = int(np.argmin(dist))
+            target = res.eigenvalues[i]
+            f_new = abs(target.imag) / (2 * np.pi)
+            if abs(f_new - f) <= FREQUENCY_TOLERANCE * max(f_new, 1e-300):
                 break
             f = f_new
-    return ModalResult(base.thrust, base.linearization, vals, shapes, part)
+        taken.setdefault(f, set()).add(i)
+        vals[j], shapes[:, j], part[j] = res.eigenvalues[i], res.shapes[:, i], res.participation[i]
+    order = np.lexsort((vals.real, np.abs(vals.imag)))
+    return ModalResult(base.thrust, base.linearization, vals[order], shapes[:, order], part[order])
+
+
+#: relative change of a mode's frequency that ends the fluid fixed point; modes whose frequencies
+#: agree to it share one eigenproblem
+FREQUENCY_TOLERANCE = 1e-12

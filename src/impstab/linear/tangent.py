@@ -29,13 +29,17 @@ from ..kinematics.so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _ske
 from ..model.mount_law import LAW_K3_AXIAL, N_LAW, law_gradient, law_hessian
 
 __all__ = ["pose_forces", "static_equilibrium_packed", "linearize_batch", "classical_forms", "MAX_PREDICTOR",
-           "NEWTON_FLOOR"]
+           "NEWTON_FLOOR", "RESIDUAL_FLOOR"]
 
 #: largest accepted predictor step of the continuation (rad, or fraction of the length scale)
 MAX_PREDICTOR = 0.02
 #: Newton corrections below this (relative to the length scale, or rad) that stop shrinking are
 #: rounding: the equilibrium is converged
 NEWTON_FLOOR = 1e-9
+#: a pose whose force and moment residuals are below this fraction of the thrust (and of the
+#: thrust times the length scale) is an equilibrium to rounding, whatever correction Newton's
+#: ill-conditioned tangent would still make (very soft mounts under a large thrust)
+RESIDUAL_FLOOR = 64 * 2.220446049250313e-16
 
 
 @njit(cache=True)
@@ -127,7 +131,12 @@ def static_equilibrium_packed(
     converged. Returns ``(u, rot, iterations, converged)``.
 
     Convergence: a correction below ``1e-13`` (relative to the length scale, or rad) twice, or
-    one below ``NEWTON_FLOOR`` that is no smaller than the one before it. The second rule
+    one below ``NEWTON_FLOOR`` that is no smaller than the one before it, or a residual below
+    ``RESIDUAL_FLOOR`` times the thrust (force) and the thrust times the length scale (moment),
+    the rounding level of the balance: where the tangent is ill-conditioned (a shear stiffness
+    of 1 N/m under 0.5 MN leaves a lateral stiffness of 0.06 N/m) the rounding of the forces
+    moves Newton's corrections above ``NEWTON_FLOOR`` although the pose balances to rounding
+    (a backward-stable equilibrium; the pose itself is then defined only to that size). The second rule
     recognises the rounding floor of the equilibrium: where the mounts are very soft against
     the thrust (a shear stiffness of 1 N/m under 8 kN) rounding of the forces alone moves the
     pose by more than ``1e-13``, and Newton's corrections stop shrinking there instead of
@@ -152,6 +161,10 @@ def static_equilibrium_packed(
                 qf, kel, kpre, kthr, _ = pose_forces(
                     u, rot, load, positions, stiffness, damping, e_dir, r_thrust, tangency, laws
                 )
+                floor = RESIDUAL_FLOOR * abs(load)
+                if it > 0 and np.max(np.abs(qf[:3])) <= floor and np.max(np.abs(qf[3:])) <= floor * length_scale:
+                    converged = True  # balanced to rounding
+                    break
                 step = np.linalg.solve(kel + kpre + kthr, qf)
                 total += 1
                 if not np.all(np.isfinite(step)):

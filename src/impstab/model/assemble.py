@@ -400,7 +400,7 @@ def _assemble(doc: ModelFile, name: str, source: str | None) -> Model:
     fluid, hull = _fluid(doc)
     return Model(
         body=body, mounts=mounts, thrust=thrust,
-        analysis=AnalysisSettings(float(thrust_max), doc.analysis.linearization),
+        analysis=AnalysisSettings(float(thrust_max), doc.analysis.linearization, _damping_threshold(doc.analysis)),
         propeller=prop, fluid=fluid, hull=hull, name=name, source=source,
         excitation=excitation_from_spec(doc.excitation, prop), foundation=foundation_from_spec(doc.foundation),
     )
@@ -517,3 +517,11 @@ def load_model(path: str | os.PathLike[str]) -> Model:
     """
     data = read_toml(path)
     return model_from_dict(data, name=Path(path).stem, source=str(path))
+
+
+def _damping_threshold(analysis) -> float | None:
+    """``analysis.min_damping_ratio``, or the damping ratio of ``analysis.min_log_decrement``."""
+    from .criteria import damping_threshold
+
+    return damping_threshold(analysis.min_damping_ratio, analysis.min_log_decrement,
+                             names=("analysis.min_damping_ratio", "analysis.min_log_decrement"))

@@ -33,10 +33,14 @@ class AnalysisSettings:
     linearization : {"equilibrium", "classical"}
         ``"equilibrium"`` linearizes at the nonlinear static equilibrium under thrust (default);
         ``"classical"`` at the undeformed configuration, exactly linear in thrust (paper eq. 21).
+    min_damping_ratio : float or None
+        Damping-ratio threshold of the practical critical thrust (from ``min_damping_ratio``, or
+        converted from ``min_log_decrement``); None: no practical criterion.
     """
 
     thrust_max: float
     linearization: str = "equilibrium"
+    min_damping_ratio: float | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -200,6 +200,13 @@ MODEL_REFERENCE: dict[str, E] = {
                              "(required when no operating thrust is given).", "thrust_max"),
     "analysis.linearization": E("", "\"equilibrium\": the tangent at the nonlinear static equilibrium under thrust; "
                                 "\"classical\": at the undeformed configuration (the paper's eq. 21)."),
+    "analysis.min_damping_ratio": E("1", "Practical stability criterion: the practical critical thrust is the first "
+                                    "thrust at which the least damping ratio -Re(lambda)/|lambda| of any mode falls to "
+                                    "this value (give it or min_log_decrement, not both); see docs/practical-stability.md.",
+                                    "minimum damping ratio"),
+    "analysis.min_log_decrement": E("1", "The practical criterion as a logarithmic decrement -2 pi Re(lambda)/Im(lambda) "
+                                    "(API 617 and API 684 ask for at least 0.1); converted to the damping ratio "
+                                    "delta / sqrt(4 pi^2 + delta^2).", "minimum logarithmic decrement"),
     # [excitation]
     "excitation": E("", "Operating excitation for the forced response (`impstab response --excitation`); "
                     "see docs/isolation.md."),

@@ -323,6 +323,8 @@ class PropellerSpec(_Strict):
 class AnalysisSpec(_Strict):
     thrust_max: Optional[Thrust] = None
     linearization: Literal["equilibrium", "classical"] = "equilibrium"
+    min_damping_ratio: Optional[number("damping_ratio")] = None  # 1, practical criterion
+    min_log_decrement: Optional[number("log_decrement")] = None  # 1, practical criterion
 
 
 # -- forced response and isolation (docs/isolation.md) ------------------------------------------

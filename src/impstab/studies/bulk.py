@@ -114,7 +114,7 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
         return None
     if model.is_damped or model.fluid.compressible or model.propeller.polar_inertia * model.propeller.speed != 0.0:
         return None
-    if model.is_nonlinear:
+    if model.is_nonlinear or model.analysis.min_damping_ratio is not None:  # the practical onset: per model
         return None
     if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: per-variant path
         return None

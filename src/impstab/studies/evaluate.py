@@ -133,6 +133,8 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
         "omega": res.omega,
         "margin": res.margin,
         "undamped_critical_thrust": res.undamped_thrust,
+        "practical_critical_thrust": res.practical_thrust,
+        "practical_margin": res.practical_margin,
         "thrust_max": res.thrust_max,
         "operating_thrust": res.operating,
         "kind": res.kind,

@@ -54,6 +54,9 @@ OUTPUTS = {
     "margin": ("1", "critical thrust / operating thrust"),
     "undamped_critical_thrust": ("N", "critical thrust with every damper removed"),
     "undamped_kind": ("", "kind of instability with every damper removed"),
+    "practical_critical_thrust": ("N", "first thrust at which the least damping ratio falls to "
+                                  "analysis.min_damping_ratio (or min_log_decrement); NaN without one"),
+    "practical_margin": ("1", "practical critical thrust / operating thrust"),
     "modes": ("", "dofs with at least 5 % of the kinetic energy of the critical mode"),
     "thrust_max": ("N", "upper end of the critical-thrust search"),
     "operating_thrust": ("N", "operating thrust"),

@@ -12,6 +12,7 @@ from ..critical_thrust import PARTICIPATION_THRESHOLD, _body_part, _modes
 from ..engine import Problem, StackOutcome, second_order_problem, solve, solve_affine
 from ..engine.problems import mass_solve
 from ..linearize import ModelFamily
+from ..practical import practical_onset, practical_problem
 from .results import KINDS, STATUSES, AffineDesign, BatchCriticalThrust
 
 Array = NDArray[np.float64]
@@ -22,7 +23,7 @@ def _single(model: Model) -> tuple:
     from ..critical_thrust import critical_thrust
 
     r = critical_thrust(model)
-    return (r.thrust, r.kind, r.omega, r.participation, r.warnings), (r.undamped_thrust, r.undamped_kind)
+    return (r.thrust, r.kind, r.omega, r.participation, r.warnings), (r.undamped_thrust, r.undamped_kind), r.practical_thrust
 
 
 def _affine_stack(designs: list[AffineDesign], n_scan: int, vectorized: bool):
@@ -80,12 +81,13 @@ def critical_thrust_batch(
         classification tolerance has status ``"ok"`` and the warning as its message.
     """
     n = len(models)
-    out = {k: np.full(n, np.nan) for k in ("thrust", "omega", "undamped", "t_max", "operating")}
+    out = {k: np.full(n, np.nan) for k in ("thrust", "omega", "undamped", "t_max", "operating", "practical")}
     kind, ukind = np.full(n, -1, dtype=np.int8), np.full(n, -1, dtype=np.int8)
     status = np.full(n, STATUSES.index("invalid"), dtype=np.int8)
     message, modes = [""] * n, [""] * n
     problems: list[Problem] = []
-    owner: list[tuple[int, bool]] = []
+    owner: list[tuple[int, bool | str]] = []
+    bases: dict[int, Problem] = {}
     done: dict[int, tuple] = {}
     affine_evaluations = decompositions = pairs = 0
     affine = [i for i, m in enumerate(models) if isinstance(m, AffineDesign)]
@@ -127,6 +129,10 @@ def critical_thrust_batch(
             built = [(second_order_problem(ModelFamily(model, None, damped=True), t_max, n_scan=n_scan), True)]
             if model.is_damped:
                 built.append((second_order_problem(ModelFamily(model, None, damped=False), t_max, n_scan=n_scan), False))
+            zeta = model.analysis.min_damping_ratio
+            if zeta is not None:
+                bases[i], turned = practical_problem(ModelFamily(model, None, damped=True), t_max, zeta, n_scan=n_scan)
+                built.append((turned, "practical"))
         except Exception as exc:  # noqa: BLE001 - reported per design
             status[i], message[i] = _failure(exc)
             continue
@@ -137,14 +143,22 @@ def critical_thrust_batch(
         outcomes = solve(problems, chunk=chunk) if problems else []
     else:
         outcomes = [solve([p], chunk=chunk)[0] for p in problems]
-    pairs: dict[int, dict[bool, object]] = {}
+    by_design: dict[int, dict[bool | str, object]] = {}
     for (i, damped), res in zip(owner, outcomes):
-        pairs.setdefault(i, {})[damped] = res
-    for i, pair in pairs.items():
+        by_design.setdefault(i, {})[damped] = res
+    practical: dict[int, float | None] = {}
+    for i, pair in by_design.items():
         err = next((r.error for r in pair.values() if r.error is not None), None)
         if err is not None:
             status[i], message[i] = _failure(err)
             continue
+        if "practical" in pair:
+            zeta = models[i].analysis.min_damping_ratio
+            try:
+                practical[i] = practical_onset(bases[i], pair["practical"], zeta).load
+            except Exception as exc:  # noqa: BLE001 - reported per design
+                status[i], message[i] = _failure(exc)
+                continue
         r = pair[True]
         res = (r.load, r.kind, r.omega, r.participation, r.warnings)
         und = None
@@ -152,8 +166,8 @@ def critical_thrust_batch(
             u = pair[False]
             und = (u.load, u.kind)
             res = (*res[:4], res[4] + tuple(f"undamped companion: {w}" for w in u.warnings))
-        done[i] = (res, und)
-    for i, (res, und) in done.items():
+        done[i] = (res, und, practical.get(i))
+    for i, (res, und, prac) in done.items():
         p, k, omega, part, warn = res
         status[i], message[i] = 0, "; ".join(warn)
         out["thrust"][i] = np.nan if p is None else p
@@ -161,10 +175,11 @@ def critical_thrust_batch(
         kind[i], modes[i] = KINDS.index(k), ",".join(_modes(_body_part(None, part)[1]))
         up, uk = (p, k) if und is None else und
         out["undamped"][i], ukind[i] = (np.nan if up is None else up), KINDS.index(uk)
+        out["practical"][i] = np.nan if prac is None else prac
     evaluations = sum(r.evaluations for r in outcomes) + affine_evaluations
     return BatchCriticalThrust(
         out["thrust"], kind, out["omega"], out["undamped"], ukind, out["t_max"], out["operating"],
-        modes, status, message, evaluations, decompositions, pairs,
+        modes, status, message, out["practical"], evaluations, decompositions, pairs,
     )
 
 

@@ -64,6 +64,10 @@ class BatchCriticalThrust:
         Codes into :data:`STATUSES`.
     message : list of str
         Empty when ``status`` is 0, else a one-line reason.
+    practical_thrust : (N,) float array
+        Practical critical thrust (N; :mod:`impstab.linear.practical`): the least damping ratio
+        falls to the design's ``analysis.min_damping_ratio`` there; NaN without a threshold, when
+        the threshold is kept up to ``thrust_max``, or for a failed design.
     evaluations : int
         Eigenproblems solved in total.
     decompositions, pair_problems : int
@@ -81,6 +85,7 @@ class BatchCriticalThrust:
     modes: list[str]
     status: NDArray[np.int8]
     message: list[str]
+    practical_thrust: Array | None = None
     evaluations: int = 0
     decompositions: int = 0
     pair_problems: int = 0
@@ -99,6 +104,13 @@ class BatchCriticalThrust:
     def frequency_hz(self) -> Array:
         """Onset frequency ``omega / 2 pi`` (Hz)."""
         return self.omega / (2.0 * np.pi)
+
+    @property
+    def practical_margin(self) -> Array:
+        """``practical critical / operating`` (NaN without either)."""
+        p = np.full(self.thrust.shape, np.nan) if self.practical_thrust is None else self.practical_thrust
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return p / self.operating
 
     @property
     def margin(self) -> Array:
