@@ -96,7 +96,7 @@ def test_isolator_stiffness_sits_on_its_deflection_bound(folder, capsys):
     (("path = \"mount_rings[0].k_axial\"", "path = \"mount_rings[3].k_axial\""), "variables[0].path"),
     (("isolation = \"t_surge_60\"", "isolation = \"t_other\""), "objective.isolation"),
     (("margin_min = 1.5", "margin_min = 0.0"), "constraints.margin_min"),
-    (("margin_min = 1.5", "margin_min = 1.5\nbenign_onset = true"), "constraints.benign_onset"),
+    (("margin_min = 1.5", "margin_min = 1.5\nbenign_onset = 1"), "constraints.benign_onset"),  # a flag, not a number
     (("population = 10", "population = 2"), "optimizer.population"),
     (("seed = 0", "sed = 0"), "optimizer.sed"),
 ])

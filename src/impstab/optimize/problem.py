@@ -18,6 +18,7 @@
     margin_min = 2.0                       # critical / operating thrust >= 2
     static_deflection_max = 0.008          # m, every mount
     peak_mount_load_max = 1000.0           # N, every mount
+    benign_onset = false                   # true: a supercritical Hopf point (or no onset) required
 
     [isolation]                            # as in a study file
     range_hz = [0.5, 300.0]
@@ -139,6 +140,10 @@ class Optimization:
     source: str | None = None
     model_source: str | None = None
 
+    #: require a benign onset: a supercritical Hopf point, or no onset up to thrust_max
+    #: (the post-critical analysis of each design, :mod:`impstab.postcritical`)
+    benign_onset: bool = False
+
     @property
     def outputs(self) -> tuple[str, ...]:
         """The study outputs every evaluation stores."""
@@ -146,6 +151,8 @@ class Optimization:
         if self.objective in ISOLATION_OUTPUTS:
             out.append(self.objective)
         out += ["static_deflection", "peak_mount_load"]
+        if self.benign_onset:
+            out += ["bifurcation", "lyapunov_coefficient"]
         return tuple(dict.fromkeys(out))
 
 
@@ -175,10 +182,6 @@ def optimization_from_dict(data: dict, base_dir: str | os.PathLike[str] = ".", *
         raise _schema_error(err) from None
     if doc.schema_version != 1:
         raise ModelError("schema_version", doc.schema_version, "this impstab reads optimization files with schema_version 1")
-    if doc.constraints.benign_onset:
-        raise ModelError("constraints.benign_onset", True,
-                         "is unavailable: this impstab has no batched analysis of the post-critical onset "
-                         "(its direction, subcritical or supercritical) to constrain; remove the key")
     model_path = Path(base_dir) / doc.model
     try:
         model_text = read_text(model_path, "model")
@@ -227,6 +230,7 @@ def optimization_from_dict(data: dict, base_dir: str | os.PathLike[str] = ".", *
         base_model=base, model_name=model.name, model_text=model_text,
         text=text if text is not None else json.dumps(data, default=str),
         fingerprint=hashlib.sha256(canonical.encode()).hexdigest(), source=source, model_source=str(model_path),
+        benign_onset=doc.constraints.benign_onset,
     )
 
 

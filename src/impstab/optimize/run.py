@@ -60,7 +60,19 @@ def objectives(opt: Optimization, data: dict[str, NDArray]) -> tuple[NDArray, ND
         g.append((data["static_deflection"] - opt.static_deflection_max) / opt.static_deflection_max)
     if opt.peak_mount_load_max is not None:
         g.append((data["peak_mount_load"] - opt.peak_mount_load_max) / opt.peak_mount_load_max)
+    if opt.benign_onset:
+        g.append(np.where(benign(data), -1.0, 1.0))
     return f, (np.column_stack(g) if g else np.zeros((len(margin), 0)))
+
+
+def benign(data: dict[str, NDArray]) -> NDArray:
+    """Designs whose onset is benign: a supercritical Hopf point, or no onset up to thrust_max.
+
+    A subcritical onset (a jump to a large cycle, with a fold below the critical thrust) is not,
+    nor is a degenerate one (undamped, symmetric, divergence: no proof of a benign cycle), nor a
+    design whose post-critical analysis failed (its label is empty)."""
+    label = np.asarray(data["bifurcation"]).astype(str)
+    return (np.asarray(data["status"]) == 0) & ((label == "supercritical") | (np.asarray(data["kind"]) == 0))
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,7 +112,7 @@ class OptimizationResult:
             "variables": [{"path": v.name, "low": v.low, "high": v.high, "scale": "log" if v.log else "linear"}
                           for v in opt.variables],
             "constraints": {"margin_min": opt.margin_min, "static_deflection_max": opt.static_deflection_max,
-                            "peak_mount_load_max": opt.peak_mount_load_max},
+                            "peak_mount_load_max": opt.peak_mount_load_max, "benign_onset": opt.benign_onset},
             "evaluations": int(np.count_nonzero(h.generation >= 0)), "generations": opt.generations, "population": opt.population,
             "batched_calls": int((h.generation >= 0).any() and h.generation.max() + 1), "polish_evaluations": self.polish_evaluations,
             "feasible_designs": int(h.feasible.sum()), "pareto_designs": int(self.pareto.dataset.sizes["sample"]),
@@ -155,6 +167,7 @@ def run_optimization(opt: Optimization, store: str | None = None, model_out: str
         return objectives(opt, evaluate_designs(opt, x))
 
     n_con = sum(v is not None for v in (opt.margin_min, opt.static_deflection_max, opt.peak_mount_load_max))
+    n_con += int(opt.benign_onset)
     hist = search(evaluate, var, 2, n_con, population=opt.population, generations=opt.generations, seed=opt.seed)
     feasible = hist.feasible
     notes: list[str] = []
@@ -183,6 +196,9 @@ def run_optimization(opt: Optimization, store: str | None = None, model_out: str
         "static_deflection": float(data["static_deflection"][0]), "peak_mount_load": float(data["peak_mount_load"][0]),
         "critical_thrust": float(data["critical_thrust"][0]), "polished": polished, "feasible": True,
     }
+    if opt.benign_onset:
+        chosen["bifurcation"] = str(data["bifurcation"][0]) or None
+        chosen["lyapunov_coefficient"] = float(data["lyapunov_coefficient"][0])
     written = None
     if model_out is not None:
         d = pareto.model_dict(params)
