@@ -49,11 +49,12 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from ..errors import ModelError
-from ..model.assemble import _error_loc, format_location, model_from_dict, parse_toml, read_text, rule_text
+from ..model.assemble import _error_loc, format_location, parse_toml, read_text, rule_text
 from ..model.schema import Finite, Flag, Integer, Text, integer, mark_at, number
 from ..model.schema_doc import unknown_key_rule
 from ..studies.isolation import IsolationSettings, settings_from_spec
 from ..studies.paths import ParameterPath, resolve_path
+from ..studies.study import load_base_model
 from ..studies.schema import ISOLATION_OUTPUTS, IsolationSpec
 
 __all__ = ["OptimizationFile", "Optimization", "load_optimization", "optimization_from_dict", "DOC_PATH"]
@@ -182,16 +183,7 @@ def optimization_from_dict(data: dict, base_dir: str | os.PathLike[str] = ".", *
         raise _schema_error(err) from None
     if doc.schema_version != 1:
         raise ModelError("schema_version", doc.schema_version, "this impstab reads optimization files with schema_version 1")
-    model_path = Path(base_dir) / doc.model
-    try:
-        model_text = read_text(model_path, "model")
-        base = parse_toml(model_text, model_path, "model")
-    except ModelError as err:
-        raise ModelError("model", doc.model, f"{err.rule} ({model_path})") from None
-    try:
-        model = model_from_dict(base, name=model_path.stem, source=str(model_path))
-    except ModelError as err:
-        raise ModelError(f"{err.field} (in base model {doc.model})", err.value, err.rule) from None
+    model_path, model_text, base, model = load_base_model(doc.model, base_dir)
     variables: list[Variable] = []
     for i, v in enumerate(doc.variables):
         f = f"variables[{i}]"

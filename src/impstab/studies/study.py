@@ -228,6 +228,25 @@ def _sample_column(spec: ParameterSpec, par: ParameterPath, i: int, u: NDArray) 
     return _checked_array(par, np.asarray(map_samples(spec, u), dtype=np.float64), key)
 
 
+def load_base_model(name: str, base_dir: str | os.PathLike[str]) -> tuple[Path, str, dict, Any]:
+    """The base model of a study or optimisation file: ``(path, text, parsed dict, Model)``.
+
+    ``name`` is the file's ``model`` key, relative to ``base_dir``; a model that cannot be read is
+    reported under ``model``, an invalid one under its own field "(in base model NAME)".
+    """
+    model_path = Path(base_dir) / name
+    try:
+        model_text = read_text(model_path, "model")
+        base = parse_toml(model_text, model_path, "model")
+    except ModelError as err:
+        raise ModelError("model", name, f"{err.rule} ({model_path})") from None
+    try:
+        model = model_from_dict(base, name=model_path.stem, source=str(model_path))
+    except ModelError as err:
+        raise ModelError(f"{err.field} (in base model {name})", err.value, err.rule) from None
+    return model_path, model_text, base, model
+
+
 def study_from_dict(
     data: dict,
     base_dir: str | os.PathLike[str] = ".",
@@ -251,16 +270,7 @@ def study_from_dict(
         doc = StudyFile.model_validate(data)
     except ValidationError as err:
         raise _schema_error(err) from None
-    model_path = Path(base_dir) / doc.model
-    try:
-        model_text = read_text(model_path, "model")
-        base = parse_toml(model_text, model_path, "model")
-    except ModelError as err:
-        raise ModelError("model", doc.model, f"{err.rule} ({model_path})") from None
-    try:
-        model = model_from_dict(base, name=model_path.stem, source=str(model_path))
-    except ModelError as err:
-        raise ModelError(f"{err.field} (in base model {doc.model})", err.value, err.rule) from None
+    model_path, model_text, base, model = load_base_model(doc.model, base_dir)
     paths: list[ParameterPath] = []
     for i, spec in enumerate(doc.parameters):
         try:
