@@ -210,6 +210,10 @@ def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: in
         d, g = parts[1], parts[2]
     else:
         _, d, g, _ = family.matrices(np.array([p_min, 0.5 * (p_min + p_max), p_max]))
+        # a load without a static equilibrium gives NaN matrices: they say nothing about damping
+        finite = np.isfinite(d).all(axis=(-2, -1)) & np.isfinite(g).all(axis=(-2, -1))
+        if finite.any():
+            d, g = d[finite], g[finite]
     if undamped is None:
         undamped = not (d.any() or g.any())
     n = int(family.n)
