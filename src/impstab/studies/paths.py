@@ -19,7 +19,7 @@ import numpy as np
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
 from ..model.assemble import rule_text
-from ..model.schema import FlagMark, IntegerMark, ModelFile, RangeMark
+from ..model.schema import FlagMark, IntegerMark, ModelFile, RangeMark, _strip
 
 __all__ = ["ParameterPath", "parse_path", "resolve_path", "set_values", "variant_dict"]
 
@@ -46,23 +46,6 @@ def _location(segments: tuple) -> str:
     for s in segments:
         text += f"[{s}]" if isinstance(s, int) else ("." if text else "") + s
     return text or "(model file)"
-
-
-def _strip(tp: Any) -> tuple[Any, list]:
-    """Remove ``Optional`` and ``Annotated`` wrappers; returns the core type and the metadata."""
-    meta: list = []
-    while True:
-        origin = typing.get_origin(tp)
-        if origin is Annotated:
-            meta.extend(tp.__metadata__)
-            tp = tp.__origin__
-        elif origin in (Union, types.UnionType):
-            args = [a for a in typing.get_args(tp) if a is not type(None)]
-            if len(args) != 1:
-                return tp, meta
-            tp = args[0]
-        else:
-            return tp, meta
 
 
 def _is_list(tp: Any) -> bool:
