@@ -21,7 +21,7 @@ written in first-order form).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 from numpy.typing import NDArray
 
 __all__ = ["unstable_masks", "classify_eigenvalues"]
