@@ -139,3 +139,21 @@ print(json.dumps([r.load, impstab._jit.compiled()]))
     # K = diag(1, 4) + p [[0, 1], [-1, 0]]: s^2 - 5 s + 4 + p^2 = 0 has a double root at p = 3/2
     assert abs(load - 1.5) <= 1e-9
     assert compiled is (policy == "compiled")
+
+
+def test_modules_imported_after_the_process_compiled_get_compiled_kernels():
+    # compile first, then import the engine (its object-mode blocks must see numba's objmode)
+    code = """
+import json, impstab._jit as jit
+jit.require_compiled()
+import numpy as np, impstab
+from impstab.model import load_model
+r = impstab.critical_thrust(load_model('examples/imp_viscoelastic.toml'))
+m = np.eye(2); k0 = np.diag([1.0, 4.0]); k1 = np.array([[0.0, 1.0], [-1.0, 0.0]])
+p = impstab.critical_load(lambda p: (m, None, None, k0 + p * k1), p_max=5.0)
+print(json.dumps([r.thrust, p.load]))
+"""
+    thrust, load = json.loads(_python(code))
+    reference = json.loads(_python(_THRUSTS.format(names=["imp_viscoelastic.toml"]), IMPSTAB_JIT="interpreted"))
+    assert abs(thrust - reference["thrusts"]["imp_viscoelastic.toml"]) <= 1e-11 * thrust
+    assert abs(load - 1.5) <= 1e-9

@@ -83,7 +83,8 @@ class _ObjectMode:
 
 
 #: stands for ``numba.objmode`` in kernels' modules (``with objmode(status="int64"): ...``)
-objmode = _ObjectMode()
+_SHIM = _ObjectMode()
+objmode = _SHIM  # rebound to numba's own when the process compiles (for modules imported later)
 
 
 class Kernel:
@@ -196,6 +197,7 @@ def require_compiled(force: bool = False) -> None:
         for kernel in _kernels:
             kernel.dispatcher = numba.njit(**kernel.options)(kernel.py_func)
         _rebind(numba.objmode)
+        globals()["objmode"] = numba.objmode
         _compiled = True
 
 
@@ -208,6 +210,6 @@ def _rebind(numba_objmode: Any) -> None:
         for attr, value in list(namespace.items()):
             if isinstance(value, Kernel):
                 namespace[attr] = value.dispatcher
-            elif value is objmode:
+            elif value is _SHIM:
                 namespace[attr] = numba_objmode
 
