@@ -15,6 +15,7 @@ independent answers.
 * the softening example with dampers ten times lighter: l1 < 0 (the critical mode changes), and a
   run from a small displacement past T_c settles on the small cycle, not on the snubber cycle of
   the same branch; with its own dampers l1 > 0 and the run jumps to the snubber cycle;
+* snubbers engaged at the equilibrium: the same l1 on circles of 1 to 30 state scales;
 * a model whose mounts have rotational (6 x 6) stiffness, rotated at equilibrium: l1 does not
   depend on the circle (the logarithm of the rotation is continued analytically, not clamped).
 """
@@ -187,3 +188,24 @@ def test_past_the_subcritical_softening_onset_a_run_jumps_to_the_snubber_cycle()
     assert res.branch_stable[i] and res.snubber_contact[i] and res.branch_amplitude[i, 4] > 0.04
     amplitude = _settled_amplitude(model, tc + 50.0, tc, 3000.0, 5e-4)       # from 0.001 rad of pitch
     np.testing.assert_allclose(amplitude, res.branch_amplitude[i], rtol=1e-3)
+
+
+def test_snubbers_engaged_at_equilibrium_give_the_same_l1_on_every_circle():
+    # clearance 30 mm, the static deflection at the onset 0.10 m: every snubber is beyond its
+    # smoothing ramp at the equilibrium; the circles must stay there (region codes), and where a
+    # large one meets the singularity of |d| the radius is shrunk until the bound is small
+    d = _toml("imp_softening.toml")
+    for mount in d["mounts"]:
+        mount["snubber_clearance"] = 0.03
+    d["analysis"]["thrust_max"] = 2.0e5
+    model = model_from_dict(d)
+    crit = impstab.critical_thrust(model)
+    system, ns = propulsor_system(model, crit.omega)
+    x0 = ns.equilibrium(crit.thrust)
+    assert np.all(system.region(x0[None].astype(complex))[0, 1:] == 2)      # beyond the ramp on every mount
+    hs = [hopf_analysis(system, x0, crit.thrust, omega=crit.omega, radius=r, points=n, check=False)
+          for r in (1.0, 10.0, 30.0) for n in (16, 32)]
+    l1 = np.array([h.lyapunov_coefficient for h in hs])
+    err = np.array([h.lyapunov_error for h in hs])
+    assert all(h.bifurcation == "subcritical" for h in hs) and np.all(err < 1e-3 * l1)
+    assert np.ptp(l1) <= 2 * err.max()

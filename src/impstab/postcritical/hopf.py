@@ -72,6 +72,11 @@ NEAR_RESONANCE = 0.05
 #: |l1| at most this many times its error bound (a bound, not an estimate: measured errors are 1e2-1e5
 #: times smaller, docs/postcritical.md): l1 = 0 to its accuracy, the sign undecided
 L1_ZERO_FACTOR = 1.0
+#: relative accuracy of l1 aimed at: with a larger bound the circles are shrunk by RADIUS_SHRINK,
+#: RADIUS_TRIES radii at most, and the smallest bound is kept
+L1_TARGET = 1e-6
+RADIUS_SHRINK = 4.0
+RADIUS_TRIES = 3
 #: Newton refinement of the onset: |Re lambda| below this share of |lambda|
 ONSET_TOLERANCE = 1e-13
 ONSET_ITERATIONS = 40
@@ -460,13 +465,27 @@ def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> H
     om = lam.imag
     w_t = w / np.conj(np.vdot(w, mass @ q))          # w_t^H B q = 1
     adjoint = mass.T @ w_t                             # p = B^H w_t, p^H q = 1
-    c1, h20, h11, err = _first_coefficient(forms, jac, mass, q, w_t, om)
+    # the circle's radius: the given one, then smaller ones while the bound stays above
+    # L1_TARGET |l1| (a singularity or a seam closer than the radius shows as a large tail or
+    # a disagreement with the half circle); the smallest bound wins
+    best = None
+    r = radius
+    for _ in range(RADIUS_TRIES if forms.method != "analytic" else 1):
+        c1, h20, h11, err = _first_coefficient(Forms(system, x, p, radius=r, points=points), jac, mass, q, w_t, om)
+        l1_err = err / om
+        if forms.method != "analytic":
+            c1b = _first_coefficient(Forms(system, x, p, radius=r / 2, points=2 * points), jac, mass, q, w_t, om)[0]
+            l1_err = max(l1_err, abs(c1b.real - c1.real) / om)
+        if best is None or l1_err < best[3]:
+            best = (c1, h20, h11, l1_err, r)
+        if l1_err <= L1_TARGET * abs(c1.real / om):
+            break
+        r /= RADIUS_SHRINK
+    c1, h20, h11, l1_err, r = best
     l1 = c1.real / om
-    l1_err = err / om
     if forms.method != "analytic":
-        f2 = Forms(system, x, p, radius=radius / 2, points=2 * points)
-        c1b = _first_coefficient(f2, jac, mass, q, w_t, om)[0]
-        l1_err = max(l1_err, abs(c1b.real - c1.real) / om)
+        checks = dict(checks, circle_radius=float(r))
+        base["derivative_check"] = checks
     kw = dict(eigenvector=q, adjoint=adjoint, crossing_speed=float(dlam.real), frequency_slope=float(dlam.imag),
               h20=h20, h11=h11, equilibrium_slope=x_p, warnings=tuple(warnings))
     if abs(l1) <= L1_ZERO_FACTOR * l1_err:

@@ -125,13 +125,12 @@ def mount_peaks(ns, states: NDArray) -> tuple[float, float, bool]:
     contact: ``|d|`` beyond a mount's snubber clearance somewhere on the samples.
     """
     from ..dynamics.system import mount_loads
-    from ..kinematics import euler_zyx_to_matrix
     from ..model.mount_law import LAW_CLEARANCE
 
     states = np.atleast_2d(np.asarray(states, dtype=float))
     pos = np.asarray(ns.system.arrays[0])
     laws = np.asarray(ns.system.arrays[4])
-    rot = np.array([euler_zyx_to_matrix(*s[3:6]) for s in states])              # (k, 3, 3)
+    rot = _rotations(states[:, 3], states[:, 4], states[:, 5])                  # (k, 3, 3)
     d = states[:, None, :3] + np.einsum("kab,ib->kia", rot, pos) - pos[None, :, :]
     dn = np.linalg.norm(d, axis=-1)                                              # (k, mounts)
     loads = mount_loads(ns.system, np.zeros(12), states)
