@@ -69,7 +69,7 @@ TRANSVERSALITY_TOLERANCE = 1e-9
 #: a plain Hopf point with another eigenvalue this close (share of |lambda|): a warning that the
 #: normal form holds only for |p - p_c| well below (distance) / |d lambda / dp|
 NEAR_RESONANCE = 0.05
-#: |l1| at most this many times its error bound (a bound, not an estimate: measured errors are 1e2-1e5
+#: |l1| at most this many times its error bound (a bound, not an estimate: measured errors are 1e2-1e6
 #: times smaller, docs/postcritical.md): l1 = 0 to its accuracy, the sign undecided
 L1_ZERO_FACTOR = 1.0
 #: relative accuracy of l1 aimed at: with a larger bound the circles are shrunk by RADIUS_SHRINK,
@@ -457,7 +457,7 @@ def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> H
                          frequency_slope=float(dlam.imag) if transversal else None,
                          bifurcation="degenerate", reason=reason, h20=None, h11=None,
                          equilibrium_slope=x_p if transversal else None, warnings=tuple(warnings), **base)
-    near = _near_eigenvalue_warning(spec, idx, lam, kappa, dlam, system.parameter_units)
+    near = _near_eigenvalue_warning(spec, idx, lam, kappa, dlam, system)
     if near:
         warnings.append(near)
     if lam.imag < 0:
@@ -522,7 +522,7 @@ def _first_coefficient(forms: Forms, jac, mass, q, w_t, om) -> tuple[complex, CA
     return complex(g / 2), h20, h11, float(err)
 
 
-def _near_eigenvalue_warning(spec: Spectrum, idx, lam, kappa, dlam, units: str) -> str | None:
+def _near_eigenvalue_warning(spec: Spectrum, idx, lam, kappa, dlam, system: DynamicalSystem) -> str | None:
     """A warning when another eigenvalue lies within NEAR_RESONANCE |lambda| of the simple critical one."""
     others = np.delete(spec.eigenvalues, idx)
     if not others.size:
@@ -532,12 +532,13 @@ def _near_eigenvalue_warning(spec: Spectrum, idx, lam, kappa, dlam, units: str) 
     if gap > NEAR_RESONANCE * abs(lam):
         return None
     span = gap / abs(dlam) if math.isfinite(abs(dlam)) and abs(dlam) > 0 else math.nan
-    unit = f" {units}" if units else ""
-    return (f"a simple pair with a near neighbour: eigenvalue {complex(others[k]):.6g} lies {gap:.3g} from the critical "
-            f"one ({gap / abs(lam):.2e} of |lambda|; eigenvalue condition number {kappa:.3g}). The Hopf theory and the "
-            f"label hold, but the single-pair normal form describes the cycles only close to the onset: for "
-            f"|p - p_c| well below gap / |d lambda/dp| = {span:.3g}{unit}, where the neighbouring mode stays out of "
-            "the motion; farther out only the computed branch is reliable")
+    name = system.parameter_name
+    unit = f" {system.parameter_units}" if system.parameter_units else ""
+    return (f"near neighbour: eigenvalue {complex(others[k]):.6g} lies {gap:.3g} 1/{system.time_units} from the "
+            f"critical one ({gap / abs(lam):.2e} of |lambda|, eigenvalue condition number {kappa:.3g}). The pair is "
+            f"simple, so the Hopf theory and its label hold, but the single-pair normal form describes the cycles "
+            f"only for |{name} - {name}_c| well below gap / |d lambda/d {name}| = {span:.3g}{unit}; farther out only "
+            "the computed branch is reliable")
 
 
 def _degeneracy(jac, mass, spec: Spectrum, idx, lam, kappa, dlam, scale) -> tuple[str | None, int]:
