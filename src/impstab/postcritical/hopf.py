@@ -72,11 +72,11 @@ NEAR_RESONANCE = 0.05
 #: |l1| at most this many times its error bound (a bound, not an estimate: measured errors are 1e2-1e6
 #: times smaller, docs/postcritical.md): l1 = 0 to its accuracy, the sign undecided
 L1_ZERO_FACTOR = 1.0
-#: relative accuracy of l1 aimed at: with a larger bound the circles are shrunk by RADIUS_SHRINK,
-#: RADIUS_TRIES radii at most, and the smallest bound is kept
+#: relative accuracy of l1 aimed at: while the bound is larger, the circles are tried at these
+#: multiples of the given radius in turn (a larger one: less rounding; smaller ones: a singularity
+#: or seam nearer than the radius), and the smallest bound is kept
 L1_TARGET = 1e-6
-RADIUS_SHRINK = 4.0
-RADIUS_TRIES = 3
+RADIUS_LADDER = (1.0, 4.0, 0.25, 1.0 / 16.0)
 #: Newton refinement of the onset: |Re lambda| below this share of |lambda|
 ONSET_TOLERANCE = 1e-13
 ONSET_ITERATIONS = 40
@@ -291,6 +291,8 @@ def hopf_analysis(
         convergence); ``False`` analyses at ``p0`` as given.
     radius, points : float, int
         Cauchy circle of the second and third derivatives (radius in units of the state scale).
+        While the bound of ``l1`` exceeds ``L1_TARGET |l1|``, circles of ``RADIUS_LADDER`` times
+        ``radius`` are tried too, and the smallest bound is kept (``derivative_check["circle_radius"]``).
     check : bool
         Compare the complex-step Jacobian with central differences and the forms between two
         circles (:func:`impstab.postcritical.derivatives.check_derivatives`); a Jacobian
@@ -469,8 +471,8 @@ def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> H
     # L1_TARGET |l1| (a singularity or a seam closer than the radius shows as a large tail or
     # a disagreement with the half circle); the smallest bound wins
     best = None
-    r = radius
-    for _ in range(RADIUS_TRIES if forms.method != "analytic" else 1):
+    ladder = [radius * f for f in RADIUS_LADDER] if forms.method != "analytic" else [radius]
+    for r in ladder:
         c1, h20, h11, err = _first_coefficient(Forms(system, x, p, radius=r, points=points), jac, mass, q, w_t, om)
         l1_err = err / om
         if forms.method != "analytic":
@@ -480,7 +482,6 @@ def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> H
             best = (c1, h20, h11, l1_err, r)
         if l1_err <= L1_TARGET * abs(c1.real / om):
             break
-        r /= RADIUS_SHRINK
     c1, h20, h11, l1_err, r = best
     l1 = c1.real / om
     if forms.method != "analytic":
