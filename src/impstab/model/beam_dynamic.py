@@ -29,12 +29,17 @@ The beam material is undamped: the model file has no loss factor for beam mounts
 ``K_d`` is real; viscous dampers given with the mount act in parallel at its ends.
 
 Conditioning. ``expm(B L)`` grows like ``exp(lambda_max L)`` with the largest real part of the
-eigenvalues of ``B`` (the evanescent bending wave), and forming ``T12^-1`` loses about
-``2 lambda_max L / ln 10`` digits (:attr:`BeamDynamicStiffness.lost_digits`, reported by the
-forced response above :data:`LOST_DIGITS_WARNING`). Soft elastomer mounts stay far below it in
-the audible range; a long slender steel rod at tens of kHz does not. Why not a finite-element mesh:
-its error grows with frequency (the consistent-mass resonances converge from above, as ``h^2``);
-the transfer matrix is exact up to that stated rounding.
+eigenvalues of ``B`` (the evanescent bending wave), and inverting its block ``T12`` would lose about
+``2 lambda_max L / ln 10`` digits: a long slender steel rod at tens of kHz loses them all. So where
+``lambda_max L`` exceeds :data:`SEGMENT_GROWTH` the beam is cut into ``2^p`` equal segments, each
+its own exact transfer matrix, joined by exact condensation of the inner nodes (still no
+discretisation: the segments are exact). The digits one segment may lose are
+:attr:`BeamDynamicStiffness.lost_digits` (below one); the forced response warns above
+:data:`LOST_DIGITS_WARNING`. The condensation divides by the joined segments' clamped-clamped
+dynamic stiffness, singular exactly at their resonances (a rounding effect within about 1e-10 of
+such a frequency, in relative terms). Why not a finite-element mesh: its error grows with
+frequency (the consistent-mass resonances converge from above, as ``h^2``); the transfer matrix is
+exact up to that rounding.
 """
 
 from __future__ import annotations
@@ -55,35 +60,71 @@ Array = NDArray[np.float64]
 LOST_DIGITS_WARNING = 6.0
 
 
-def _component_stiffness(b: Array, length: float) -> tuple[Array, Array]:
-    """``(nf, 2m, 2m)`` end stiffness ``[[f0], [fL]] = K [[d0], [dL]]`` of one component with state
-    matrices ``b (nf, 2m, 2m)``, and the largest real part of their eigenvalues ``(nf,)``."""
-    m = b.shape[-1] // 2
-    t = sla.expm(b * length)
+#: largest ``lambda_max h`` of one segment's transfer matrix ``expm(B h)`` (growth ``e^2``: under two
+#: digits lost to its inversion)
+SEGMENT_GROWTH = 2.0
+
+
+def _two_port(t: Array) -> Array:
+    """End stiffness ``[[f0], [fh]] = K [[d0], [dh]]`` of a segment from its transfer matrix."""
+    m = t.shape[-1] // 2
     t11, t12, t21, t22 = t[:, :m, :m], t[:, :m, m:], t[:, m:, :m], t[:, m:, m:]
-    eye = np.broadcast_to(np.eye(m), t12.shape)
-    inv12 = np.linalg.solve(t12, eye)
+    inv12 = np.linalg.solve(t12, np.broadcast_to(np.eye(m), t12.shape))
     k = np.empty_like(t)
     k[:, :m, :m] = inv12 @ t11
     k[:, :m, m:] = -inv12
     k[:, m:, :m] = t21 - t22 @ inv12 @ t11
     k[:, m:, m:] = t22 @ inv12
+    return k
+
+
+def _doubled(k: Array) -> Array:
+    """Two equal segments joined end to end, the middle node condensed exactly."""
+    m = k.shape[-1] // 2
+    a11, a12, a21, a22 = k[:, :m, :m], k[:, :m, m:], k[:, m:, :m], k[:, m:, m:]
+    s = a22 + a11
+    left = np.linalg.solve(s, a21)        # S^-1 A21
+    right = np.linalg.solve(s, a12)       # S^-1 B12 (B = A)
+    out = np.empty_like(k)
+    out[:, :m, :m] = a11 - a12 @ left
+    out[:, :m, m:] = -a12 @ right
+    out[:, m:, :m] = -a21 @ left
+    out[:, m:, m:] = a22 - a21 @ right
+    return out
+
+
+def _component_stiffness(b: Array, length: float) -> tuple[Array, Array]:
+    """``(nf, 2m, 2m)`` end stiffness ``[[f0], [fL]] = K [[d0], [dL]]`` of one component with state
+    matrices ``b (nf, 2m, 2m)``, and the digits one segment's transfer matrix may lose ``(nf,)``.
+
+    Where the evanescent wave grows by more than ``e^SEGMENT_GROWTH`` over the length, the beam is
+    cut into ``2^p`` equal segments (each its exact transfer matrix) joined by exact condensation of
+    the inner nodes (``p`` doublings): exact still, without the inversion of ``expm(B L)`` that
+    would lose ``2 lambda_max L / ln 10`` digits.
+    """
     grow = np.linalg.eigvals(b).real.max(axis=-1)
-    return k, grow
+    p = int(max(0, np.ceil(np.log2(max(float(grow.max()) * length / SEGMENT_GROWTH, 1.0)))))
+    h = length / 2**p
+    k = _two_port(sla.expm(b * h))
+    for _ in range(p):
+        k = _doubled(k)
+    return k, 2.0 * grow * h / np.log(10.0)
 
 
-def dynamic_stiffness_local(beam: BeamMount, omega: ArrayLike) -> tuple[Array, Array]:
+def dynamic_stiffness_local(beam: BeamMount, omega: ArrayLike, rotary_inertia: bool = True) -> tuple[Array, Array]:
     """Exact 12 x 12 dynamic stiffness in the beam frame at angular frequencies ``omega`` (rad/s).
 
     Dofs ``(u1, u2, u3, theta1, theta2, theta3)`` of the hull end, then of the body end; forces
-    and moments applied to the beam. Returns ``(K (nf, 12, 12), lost_digits (nf,))``.
+    and moments applied to the beam. ``rotary_inertia=False`` drops the sections' rotary inertia
+    in bending (with a large shear coefficient: the Euler-Bernoulli beam). Returns
+    ``(K (nf, 12, 12), lost_digits (nf,))``.
     """
     w2 = np.asarray(omega, dtype=float).reshape(-1) ** 2
     nf = w2.size
     E, G, rho, L = beam.youngs_modulus, beam.shear_modulus, beam.density, beam.length
     A, I, J, kap = beam.area, beam.second_moment, beam.polar_moment, beam.shear_coefficient
     out = np.zeros((nf, 12, 12))
-    grow = np.zeros(nf)
+    grow = np.zeros(nf)  # digits lost, the worst component
     # axial (dof 0) and torsion (dof 3): y = [d, s]
     for dof, stiff, inertia in ((0, E * A, rho * A), (3, G * J, rho * J)):
         b = np.zeros((nf, 2, 2))
@@ -99,7 +140,7 @@ def dynamic_stiffness_local(beam: BeamMount, omega: ArrayLike) -> tuple[Array, A
     b[:, 0, 2] = 1.0 / (kap * G * A)  # type: ignore[operator]
     b[:, 1, 3] = 1.0 / (E * I)
     b[:, 2, 0] = -rho * A * w2
-    b[:, 3, 1] = -rho * I * w2
+    b[:, 3, 1] = -rho * I * w2 if rotary_inertia else 0.0
     b[:, 3, 2] = -1.0
     kb, g = _component_stiffness(b, L)
     grow = np.maximum(grow, g)
@@ -108,7 +149,7 @@ def dynamic_stiffness_local(beam: BeamMount, omega: ArrayLike) -> tuple[Array, A
         idx = [disp, rot, disp + 6, rot + 6]
         s = np.diag([1.0, sign, 1.0, sign])
         out[np.ix_(range(nf), idx, idx)] = s @ kb @ s
-    return out, 2.0 * grow * L / np.log(10.0)
+    return out, grow
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,7 +163,7 @@ class BeamDynamicStiffness:
     full : (nf, 12, 12) array
         Both ends free: dofs of the hull end, then of the body end (translations, rotations).
     lost_digits : (nf,) array
-        Decimal digits the transfer-matrix inversion may lose (``2 lambda_max L / ln 10``).
+        Decimal digits one segment's transfer-matrix inversion may lose (``2 lambda_max h / ln 10``).
     """
 
     omega: Array
