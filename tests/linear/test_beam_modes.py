@@ -89,3 +89,19 @@ def test_locus_merges_at_the_critical_thrust():
     assert abs(top.imag) == pytest.approx(crit.omega, rel=1e-2)
     fig = res.plot()
     assert len(fig.frequency.get_lines()) > 0
+
+
+def test_symmetric_layout_keeps_its_two_planes_in_the_locus():
+    # the example's four beams on a symmetric ring: with internal dofs the two identical planes are
+    # one group of dofs; the body branches must still be those of the massless beams
+    example = Path(__file__).resolve().parents[2] / "examples" / "imp_beam_mounts.toml"
+    model = impstab.load_model(example)
+    massless = replace(model, mounts=tuple(replace(m, beam=replace(m.beam, density=0.0)) for m in model.mounts))
+    thrusts = np.linspace(0.0, 40000.0, 17)
+    grown, plain = impstab.locus(model, thrusts), impstab.locus(massless, thrusts)
+    body = grown.body_branches()
+    assert body.branch_labels() == plain.branch_labels()
+    assert np.array_equal(body.mode, plain.mode)
+    # column by column the same tracks, up to the beams' inertia (a 3e-3 mass share)
+    scale = np.abs(plain.eigenvalues).max()
+    assert np.abs(body.eigenvalues - plain.eigenvalues).max() < 1e-2 * scale

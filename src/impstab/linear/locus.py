@@ -392,7 +392,10 @@ def _tracked_branches(m, c, k, operators=None):
             sub = (slice(None),) + ix
             ops = state_matrices(m[rows][sub], c[rows][sub], k[rows][sub]) if operators is None else operators[rows]
             lam, vec = np.linalg.eig(ops)
-            lam, vec = track_modes(lam, vec)
+            if operators is None and n > 6:  # massive beam mounts: body and internal modes apart
+                lam, vec = _track_body_and_internal(lam, vec, np.diagonal(m[rows][sub], axis1=1, axis2=2))
+            else:
+                lam, vec = track_modes(lam, vec)
             for other in done:
                 perm = matching_order(other, lam)
                 if perm is not None:  # identical planes: continue through coalescences alike
@@ -409,7 +412,7 @@ def _tracked_branches(m, c, k, operators=None):
             full = np.zeros((rows.size, width, n))
             full[:, :, dofs] = np.transpose(w, (0, 2, 1))
             shares[rows[:, None], cols[None, :], :] = full
-            groups = _conjugate_groups(lam)
+            groups = _conjugate_groups(lam, vec if operators is None and n > 6 else None)
             for gcols in groups:
                 mode[col + gcols] = len(first_freq)
                 first_freq.append(float(np.abs(lam[0, gcols].imag).max()))
@@ -422,6 +425,39 @@ def _tracked_branches(m, c, k, operators=None):
     # columns listed branch by branch, the upper member of a pair first
     key = np.lexsort((-np.nan_to_num(vals[rows[0]].imag if rows.size else np.zeros(size)), mode))
     return vals[:, key], shares[:, key, :], mode[key]
+
+
+def _track_body_and_internal(lam, vec, m_diag):
+    """Tracking of a system grown by the internal dofs of massive beam mounts.
+
+    The body's eigenvalues (most kinetic energy in the first six dofs) and the mounts' internal
+    ones are tracked apart: tracked together, the distance scale of the assignment is the internal
+    modes' (hundreds of Hz) and the body's branches would be matched by their eigenvectors alone.
+    Each repeated body eigenvalue (two identical planes of a symmetric layout, which the internal
+    dofs join into one group of dofs) gets a solver-independent basis first
+    (:func:`impstab.linear.modes._canonical_repeated`). Rows whose body count differs from the
+    first row's are tracked as one set.
+    """
+    from .modes import _canonical_repeated
+
+    n = m_diag.shape[1]
+    w = np.abs(vec[:, :n, :]) ** 2 * m_diag[:, :, None]
+    body = w[:, :6, :].sum(axis=1) > 0.5 * w.sum(axis=1)             # (rows, 2n)
+    count = body.sum(axis=1)
+    if not np.all(count == count[0]) or count[0] == 0:
+        return track_modes(lam, vec)
+    k = int(count[0])
+    order = np.argsort(~body, axis=1, kind="stable")                  # body columns first
+    lam = np.take_along_axis(lam, order, axis=1)
+    vec = np.take_along_axis(vec, order[:, None, :], axis=2)
+    weight = np.concatenate([m_diag, m_diag], axis=1)
+    for r in range(lam.shape[0]):
+        sort = np.lexsort((lam[r, :k].real, lam[r, :k].imag))
+        lam[r, :k] = lam[r, :k][sort]
+        vec[r, :, :k] = _canonical_repeated(lam[r, :k], vec[r, :, :k][:, sort], weight[r])
+    lb, vb = track_modes(lam[:, :k], vec[:, :, :k])
+    li, vi = track_modes(lam[:, k:], vec[:, :, k:])
+    return np.concatenate([lb, li], axis=1), np.concatenate([vb, vi], axis=2)
 
 
 def matching_order(ref: NDArray[np.complex128], lam: NDArray[np.complex128]) -> NDArray[np.int64] | None:
@@ -447,8 +483,13 @@ def matching_order(ref: NDArray[np.complex128], lam: NDArray[np.complex128]) -> 
     return perm
 
 
-def _conjugate_groups(lam: NDArray[np.complex128]) -> list[NDArray[np.int64]]:
-    """Columns of a tracked set that form one mode: linked where one is the conjugate of another."""
+def _conjugate_groups(lam: NDArray[np.complex128], vectors: NDArray | None = None) -> list[NDArray[np.int64]]:
+    """Columns of a tracked set that form one mode: linked where one is the conjugate of another.
+
+    ``vectors (rows, S, k)``: where several columns hold the conjugate value (identical planes that
+    one group of dofs carries), the partner is the one whose eigenvector is the conjugate of the
+    column's own (largest MAC), not the first of them.
+    """
     k = lam.shape[1]
     label = np.arange(k)
 
@@ -462,6 +503,14 @@ def _conjugate_groups(lam: NDArray[np.complex128]) -> list[NDArray[np.int64]]:
         dist = np.abs(lam[:, :, None] - np.conj(lam)[:, None, :])  # (rows, a, b)
         partner = np.argmin(np.where(np.isnan(dist), np.inf, dist), axis=-1)
         near = np.take_along_axis(dist, partner[..., None], axis=-1)[..., 0] <= _PAIR_TOL * scale
+        if vectors is not None:
+            from .tracking import mac
+
+            for r in range(lam.shape[0]):
+                cand = dist[r] <= _PAIR_TOL * scale                      # (a, b)
+                if (cand.sum(axis=1) > 1).any():
+                    fit = np.where(cand, mac(np.conj(vectors[r]), vectors[r]), -1.0)
+                    partner[r] = np.argmax(fit, axis=1)
         upper = lam.imag > _PAIR_TOL * scale
     first = np.broadcast_to(np.arange(k), partner.shape)
     linked = upper & near & (partner != first)
