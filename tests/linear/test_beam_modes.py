@@ -105,3 +105,16 @@ def test_symmetric_layout_keeps_its_two_planes_in_the_locus():
     # column by column the same tracks, up to the beams' inertia (a 3e-3 mass share)
     scale = np.abs(plain.eigenvalues).max()
     assert np.abs(body.eigenvalues - plain.eigenvalues).max() < 1e-2 * scale
+
+
+def test_the_roll_mode_of_the_decoupling_check_is_a_body_mode():
+    from impstab.response.decoupling import decoupling_check
+
+    model = _massive(8)
+    md = impstab.modes(model, 0.0)
+    check = decoupling_check(model, 0.0, modal=md)
+    # an internal mount mode can carry a larger roll share of its (small) body motion
+    assert md.participation[np.array(md.kind) == "mount", 3].max() > check.roll_share
+    assert md.kind[check.roll_mode] == "body"
+    body = [j for j, k in enumerate(md.kind) if k == "body"]
+    assert check.roll_mode == body[int(np.argmax(md.participation[body, 3]))]
