@@ -44,6 +44,7 @@ exact up to that rounding.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,21 +120,30 @@ def dynamic_stiffness_local(beam: BeamMount, omega: ArrayLike, rotary_inertia: b
     in bending (with a large shear coefficient: the Euler-Bernoulli beam). Returns
     ``(K (nf, 12, 12), lost_digits (nf,))``.
     """
-    w2 = np.asarray(omega, dtype=float).reshape(-1) ** 2
+    w = np.ascontiguousarray(np.asarray(omega, dtype=float).reshape(-1))
+    return _local_cached(beam, w.tobytes(), bool(rotary_inertia))
+
+
+@functools.lru_cache(maxsize=2)
+def _local_cached(beam: BeamMount, omega_bytes: bytes, rotary_inertia: bool) -> tuple[Array, Array]:
+    """:func:`dynamic_stiffness_local` of one beam at one frequency grid, kept for the mounts that
+    share both (a ring of equal mounts, the response and its conditioning note); read-only."""
+    w2 = np.frombuffer(omega_bytes, dtype=float) ** 2
     nf = w2.size
     E, G, rho, L = beam.youngs_modulus, beam.shear_modulus, beam.density, beam.length
     A, I, J, kap = beam.area, beam.second_moment, beam.polar_moment, beam.shear_coefficient
     out = np.zeros((nf, 12, 12))
     grow = np.zeros(nf)  # digits lost, the worst component
     # axial (dof 0) and torsion (dof 3): y = [d, s]
+    # (no evanescent wave: expm(B L) in closed form, cos and sin of kL, k = omega sqrt(inertia / stiff))
     for dof, stiff, inertia in ((0, E * A, rho * A), (3, G * J, rho * J)):
-        b = np.zeros((nf, 2, 2))
-        b[:, 0, 1] = 1.0 / stiff
-        b[:, 1, 0] = -inertia * w2
-        k, g = _component_stiffness(b, L)
+        kl = np.sqrt(w2 * inertia / stiff) * L
+        t = np.empty((nf, 2, 2))
+        t[:, 0, 0] = t[:, 1, 1] = np.cos(kl)
+        t[:, 0, 1] = L / stiff * np.sinc(kl / np.pi)                     # sin(kL) / (stiff k)
+        t[:, 1, 0] = -inertia * w2 * L * np.sinc(kl / np.pi)             # -stiff k sin(kL)
         idx = [dof, dof + 6]
-        out[np.ix_(range(nf), idx, idx)] = k
-        grow = np.maximum(grow, g)
+        out[np.ix_(range(nf), idx, idx)] = _two_port(t)
     # bending, y = [v, theta, V, M]
     b = np.zeros((nf, 4, 4))
     b[:, 0, 1] = 1.0
@@ -149,6 +159,8 @@ def dynamic_stiffness_local(beam: BeamMount, omega: ArrayLike, rotary_inertia: b
         idx = [disp, rot, disp + 6, rot + 6]
         s = np.diag([1.0, sign, 1.0, sign])
         out[np.ix_(range(nf), idx, idx)] = s @ kb @ s
+    out.flags.writeable = False
+    grow.flags.writeable = False
     return out, grow
 
 
