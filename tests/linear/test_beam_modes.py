@@ -57,6 +57,8 @@ def test_modes_at_rest_are_the_roots_of_the_exact_dynamic_stiffness():
     assert md.mount_elements == (32, 32, 32, 32) and md.internal_dofs > 0
     assert md.kind[:6] == ["body"] * 6 and md.kind[6] == "mount"
     assert np.all(md.internal_share[:6] < 1e-2) and md.internal_share[6] > 0.5
+    ds = md.to_xarray()
+    assert list(ds["kind"].values) == md.kind and np.array_equal(ds["internal_share"].values, md.internal_share)
     det = _exact_det(fine)
     # the six body modes: to 1e-6 relative (the mesh error is far below it at these frequencies)
     for w in md.omega[:6]:

@@ -157,8 +157,14 @@ class ModalResult:
 
         from .. import __version__
 
+        extra = {}
+        if self.internal_share is not None:
+            extra = {"internal_share": ("mode", self.internal_share, {
+                         "units": "1", "long_name": "kinetic-energy share of the beam mounts' internal dofs"}),
+                     "kind": ("mode", self.kind, {"long_name": "body or mount (internal mount mode)"})}
         return xr.Dataset(
             {
+                **extra,
                 "omega": ("mode", self.omega, {"units": "rad/s"}),
                 "frequency_hz": ("mode", self.frequency_hz, {"units": "Hz"}),
                 "growth_rate": ("mode", self.growth_rate, {"units": "1/s"}),
