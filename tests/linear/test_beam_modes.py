@@ -120,3 +120,16 @@ def test_the_roll_mode_of_the_decoupling_check_is_a_body_mode():
     assert md.kind[check.roll_mode] == "body"
     body = [j for j, k in enumerate(md.kind) if k == "body"]
     assert check.roll_mode == body[int(np.argmax(md.participation[body, 3]))]
+
+
+def test_modes_with_compressible_fluid_and_massive_beams_are_refused_in_one_line():
+    from impstab.errors import ModelError
+
+    data = _model()
+    for m in data["mounts"]:
+        m["beam"]["density"] = 1100.0
+    data["hull"] = {"radius": 0.2, "length": 0.8, "center": [0.1, 0.0, 0.0]}
+    data["fluid"] = {"model": "baffled-cylinder", "density": 1025.0, "sound_speed": 1500.0}
+    with pytest.raises(ModelError) as info:
+        impstab.modes(model_from_dict(data), 0.0)
+    assert info.value.field == "fluid.sound_speed" and "\n" not in str(info.value)

@@ -346,9 +346,13 @@ def _grown_modes(model: Model, thrust: float, linearization: str | None) -> Moda
     (:mod:`impstab.linear.mount_dofs`): every eigenvalue of the grown system with ``omega >= 0``;
     shapes and the decoupling table of the body dofs, the internal share of each mode's kinetic
     energy beside them."""
-    from ..errors import NumericalError
+    from ..errors import ModelError, NumericalError
     from .linearize import ModelFamily
 
+    if model.fluid.compressible:
+        raise ModelError("fluid.sound_speed", model.fluid.sound_speed,
+                         "the modes of a model with beam mounts with mass take the fluid incompressible only: "
+                         "leave sound_speed out (or use density = 0 for the massless beams)")
     fam = ModelFamily(model, linearization)
     m, d, g, k = (np.asarray(a[0], dtype=float) for a in fam.matrices(np.array([float(thrust)])))
     if not np.isfinite(k).all():
