@@ -105,11 +105,14 @@ def check_cmd(model_file: str) -> None:
     t.add_row("critical thrust", rows["critical thrust"] + (f" ({crit.kind})" if crit.thrust is not None else ""))
     t.add_row("margin (critical / operating)", rows["margin (critical / operating)"])
     con.print(t)
-    if any(m.is_massive_beam for m in model.mounts):  # beam mounts with mass: no 6-dof modal table
-        con.print("natural frequencies: not listed for beam mounts with mass (their internal dofs are "
-                  "carried by the critical-thrust analysis only)")
+    md = modes(model, 0.0)
+    if md.internal_share is not None:  # beam mounts with mass: the body modes, the internal ones counted
+        body = [f for f, kind in zip(md.frequency_hz, md.kind) if kind == "body"]
+        con.print("natural frequencies at zero thrust (Hz): " + ", ".join(_fmt(f, digits=4) for f in body)
+                  + f"; and {len(md.kind) - len(body)} internal mount modes from "
+                  f"{_fmt(min((f for f, k in zip(md.frequency_hz, md.kind) if k == 'mount'), default=np.nan), digits=4)}"
+                  " Hz (`impstab modes`)")
     else:
-        md = modes(model, 0.0)
         con.print("natural frequencies at zero thrust (Hz): " + ", ".join(_fmt(f, digits=4) for f in md.frequency_hz))
     for w in crit.warnings:
         con.print(f"[yellow]warning:[/yellow] {user_text(w)}")
@@ -182,15 +185,23 @@ def modes_cmd(model_file: str, thrust: float, linearization: str | None, as_json
                     "warnings": _modes_warnings(res, crit, thrust)})
         return
     scale = float(np.abs(res.eigenvalues).max(initial=0.0))
+    grown = res.internal_share is not None  # massive beam mounts: body and internal mount modes
+    extra_cols = (("kind", "left"), ("internal KE (%)", "right")) if grown else ()
     t = table(f"modes of {user_text(model.name)} at T = {thrust:g} N ({res.linearization} linearization)",
               ("mode", "right"), ("f (Hz)", "right"), ("omega (rad/s)", "right"), ("zeta (1)", "right"),
-              ("growth (1/s)", "right"), "dominant dof")
+              ("growth (1/s)", "right"), "dominant dof", *extra_cols)
     for j, dom in enumerate(res.dominant()):
+        more = (res.kind[j], f"{100 * res.internal_share[j]:.1f}") if grown else ()  # type: ignore[index]
         t.add_row(str(j + 1), _fmt(res.frequency_hz[j]), _fmt(res.omega[j]),
                   "0" if abs(res.growth_rate[j]) < 1e-10 * max(scale, 1e-300) else _fmt(res.damping_ratio[j], digits=4),
-                  growth(res.growth_rate[j], scale), "/".join(dom))
+                  growth(res.growth_rate[j], scale), "/".join(dom), *more)
     con = console()
     con.print(t)
+    if grown:
+        con.print(f"beam mounts with mass: {', '.join(map(str, res.mount_elements))} finite elements per beam, "
+                  f"{res.internal_dofs} internal (Craig-Bampton) dofs; kind 'mount': most of the mode's kinetic "
+                  "energy in the mounts' internal dofs (internal KE), else 'body'; the dof shares below are "
+                  "the body's part of the energy")
     e = table("decoupling table: kinetic-energy shares of each mode by dof (%)", ("mode", "right"),
               *((n, "right") for n in DOF_NAMES))
     for j in range(len(res.eigenvalues)):

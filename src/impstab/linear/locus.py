@@ -24,6 +24,7 @@ from ..limits import check_number
 from ..model.model import DOF_NAMES, Model
 from .eigen import state_matrices
 from .linearize import ModelFamily
+from .mount_dofs import mount_dofs
 from .tracking import track_modes
 
 __all__ = ["LocusResult", "locus", "DOMINANT_SHARE", "SAME_TOL", "matching_order"]
@@ -37,6 +38,11 @@ _PAIR_TOL = 1e-8
 SAME_TOL = 1e-6
 #: coupling between two dofs, relative to the largest entry, below which they are independent
 COUPLING_TOL = 1e-12
+#: massive beam mounts: the locus carries the beams' fixed-interface modes below this multiple of the
+#: body's highest natural frequency (the critical thrust and the modes keep those below
+#: :data:`impstab.linear.mount_dofs.CUTOFF`); the static constraint modes keep the statics exact and the
+#: body's eigenvalues move by about ``LOCUS_CUTOFF^-2`` of the dropped modes' effective mass share
+LOCUS_CUTOFF = 100.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,6 +89,17 @@ class LocusResult:
     critical_frequency_hz: float | None = None
     undamped_critical_thrust: float | None = None
     fluid_frequency_hz: float | None = None
+    internal_share: NDArray[np.float64] | None = None
+    mount_elements: tuple[int, ...] = ()
+
+    @property
+    def is_mount_branch(self) -> NDArray[np.bool_]:
+        """Per column: True for an internal mode of massive beam mounts (most of its kinetic energy
+        in the mounts' internal dofs at the first thrust); all False without such mounts."""
+        if self.internal_share is None:
+            return np.zeros(self.eigenvalues.shape[1], dtype=bool)
+        first = np.nan_to_num(self.internal_share[0], nan=0.0)
+        return first > 0.5
 
     @property
     def growth_rate(self) -> NDArray[np.float64]:
@@ -119,7 +136,10 @@ class LocusResult:
                 continue
             share = self.participation[self._naming_row(cols), cols[0]]
             names = [DOF_NAMES[i] for i in np.argsort(-share) if share[i] >= threshold]
-            out.append(", ".join(names) if names else DOF_NAMES[int(np.argmax(share))])
+            label = ", ".join(names) if names else DOF_NAMES[int(np.argmax(share))]
+            if self.is_mount_branch[cols[0]]:
+                label = f"mount internal ({label})"
+            out.append(label)
         return out
 
     def _naming_row(self, cols) -> int:
@@ -170,6 +190,10 @@ class LocusResult:
             coords["dof"] = ("dof", list(DOF_NAMES))
             data["participation"] = (("thrust", "branch", "dof"), self.participation,
                                      {"units": "1", "long_name": "kinetic-energy share of each dof in the mode"})
+        if self.internal_share is not None:
+            data["internal_share"] = (("thrust", "branch"), self.internal_share, {
+                "units": "1", "long_name": "kinetic-energy share of the beam mounts' internal dofs in the mode"})
+            attrs["mount_elements"] = list(self.mount_elements)
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     @classmethod
@@ -184,18 +208,35 @@ class LocusResult:
             ds["participation"].values if "participation" in ds else None,
             a.get("critical_kind"), _attr(a, "critical_frequency_hz"), _attr(a, "undamped_critical_thrust"),
             _attr(a, "fluid_frequency_hz"),
+            ds["internal_share"].values if "internal_share" in ds else None,
+            tuple(int(e) for e in np.atleast_1d(a.get("mount_elements", []))),
         )
 
-    def plot(self, ax=None, *, growth_scale: str = "auto"):
+    def plot(self, ax=None, *, growth_scale: str = "auto", mount_branches: bool = False):
         """Frequency (Hz) and growth rate (1/s) of every branch against thrust; returns the axes.
 
         See :func:`impstab.plot.locus.plot_locus`: ``ax`` may be None (a new figure), one Axes
         (frequency only) or a pair; the result is a :class:`~impstab.plot.LocusAxes`
-        ``(frequency, growth)``, or the one Axes given.
+        ``(frequency, growth)``, or the one Axes given. With massive beam mounts the internal
+        mount branches (:attr:`is_mount_branch`, hundreds of Hz above the body modes) are left
+        out unless ``mount_branches``.
         """
         from ..plot.locus import plot_locus
 
-        return plot_locus(self, ax=ax, growth_scale=growth_scale)
+        shown = self if mount_branches or not self.is_mount_branch.any() else self.body_branches()
+        return plot_locus(shown, ax=ax, growth_scale=growth_scale)
+
+    def body_branches(self) -> "LocusResult":
+        """The result without the internal mount branches (the same object without such mounts)."""
+        keep = ~self.is_mount_branch
+        if keep.all():
+            return self
+        from dataclasses import replace
+
+        mode = None if self.mode is None else np.unique(self.mode[keep], return_inverse=True)[1].astype(np.int64)
+        return replace(self, eigenvalues=self.eigenvalues[:, keep], mode=mode,
+                       participation=None if self.participation is None else self.participation[:, keep],
+                       internal_share=None if self.internal_share is None else self.internal_share[:, keep])
 
     def __repr__(self) -> str:
         from ..display import locus_text
@@ -242,9 +283,6 @@ def locus(
         Also compute the critical thrust (damped and undamped) over the same range and store
         it in the result (the figure marks it).
     """
-    from .mount_dofs import refuse_massive_beams
-
-    refuse_massive_beams(model, "the eigenvalue locus")
     if thrusts is None:
         if steps < 1:
             raise ModelError("steps", steps, "must be at least 1")
@@ -272,15 +310,31 @@ def locus(
         ops[good] = np.linalg.solve(e[good], a[good])
         vals, shares, mode = _tracked_branches(m, c, k, operators=ops)
     else:
-        fam = ModelFamily(model, linearization, fluid_frequency=f_fluid)
-        m, d, g, k = fam.matrices(thrusts)
+        fam = ModelFamily(model, linearization, fluid_frequency=f_fluid, mount_dofs=False)
+        internal_dofs = mount_dofs(model, cutoff=LOCUS_CUTOFF)
+        if internal_dofs is None:
+            m, d, g, k = fam.matrices(thrusts)
+        else:  # massive beam mounts: the internal dofs in the locus's frequency range
+            if fam.is_affine:
+                m, d, g, k = fam.matrices(thrusts)
+                r0 = None
+            else:
+                m, d, g, k, _, r0 = fam.evaluate(thrusts, strict=False)
+            m, d, g, k = internal_dofs.augment(np.asarray(m), np.asarray(d), np.asarray(g), np.asarray(k), r0)
         vals, shares, mode = _tracked_branches(np.asarray(m), np.asarray(d + g), np.asarray(k))
+    internal = None
+    if shares.shape[-1] > 6:  # massive beam mounts: body shares, and the internal dofs' share beside
+        internal = shares[..., 6:].sum(axis=-1)
+        body = shares[..., :6]
+        tot = body.sum(axis=-1, keepdims=True)
+        shares = body / np.where(tot > 0, tot, 1.0)
     return LocusResult(
         thrusts, vals, fam.linearization, model.name,  # type: ignore[arg-type]
         None if crit is None else crit.thrust, model.thrust.operating, mode, shares,
         None if crit is None else crit.kind, None if crit is None else crit.frequency_hz,
         None if crit is None else crit.undamped_thrust,
         f_fluid if model.fluid.compressible else None,
+        internal, tuple(int(mt.beam.elements) for mt in model.mounts if mt.is_massive_beam),
     )
 
 
@@ -338,7 +392,10 @@ def _tracked_branches(m, c, k, operators=None):
             sub = (slice(None),) + ix
             ops = state_matrices(m[rows][sub], c[rows][sub], k[rows][sub]) if operators is None else operators[rows]
             lam, vec = np.linalg.eig(ops)
-            lam, vec = track_modes(lam, vec)
+            if operators is None and n > 6:  # massive beam mounts: body and internal modes apart
+                lam, vec = _track_body_and_internal(lam, vec, np.diagonal(m[rows][sub], axis1=1, axis2=2))
+            else:
+                lam, vec = track_modes(lam, vec)
             for other in done:
                 perm = matching_order(other, lam)
                 if perm is not None:  # identical planes: continue through coalescences alike
@@ -355,7 +412,7 @@ def _tracked_branches(m, c, k, operators=None):
             full = np.zeros((rows.size, width, n))
             full[:, :, dofs] = np.transpose(w, (0, 2, 1))
             shares[rows[:, None], cols[None, :], :] = full
-            groups = _conjugate_groups(lam)
+            groups = _conjugate_groups(lam, vec if operators is None and n > 6 else None)
             for gcols in groups:
                 mode[col + gcols] = len(first_freq)
                 first_freq.append(float(np.abs(lam[0, gcols].imag).max()))
@@ -368,6 +425,39 @@ def _tracked_branches(m, c, k, operators=None):
     # columns listed branch by branch, the upper member of a pair first
     key = np.lexsort((-np.nan_to_num(vals[rows[0]].imag if rows.size else np.zeros(size)), mode))
     return vals[:, key], shares[:, key, :], mode[key]
+
+
+def _track_body_and_internal(lam, vec, m_diag):
+    """Tracking of a system grown by the internal dofs of massive beam mounts.
+
+    The body's eigenvalues (most kinetic energy in the first six dofs) and the mounts' internal
+    ones are tracked apart: tracked together, the distance scale of the assignment is the internal
+    modes' (hundreds of Hz) and the body's branches would be matched by their eigenvectors alone.
+    Each repeated body eigenvalue (two identical planes of a symmetric layout, which the internal
+    dofs join into one group of dofs) gets a solver-independent basis first
+    (:func:`impstab.linear.modes._canonical_repeated`). Rows whose body count differs from the
+    first row's are tracked as one set.
+    """
+    from .modes import _canonical_repeated
+
+    n = m_diag.shape[1]
+    w = np.abs(vec[:, :n, :]) ** 2 * m_diag[:, :, None]
+    body = w[:, :6, :].sum(axis=1) > 0.5 * w.sum(axis=1)             # (rows, 2n)
+    count = body.sum(axis=1)
+    if not np.all(count == count[0]) or count[0] == 0:
+        return track_modes(lam, vec)
+    k = int(count[0])
+    order = np.argsort(~body, axis=1, kind="stable")                  # body columns first
+    lam = np.take_along_axis(lam, order, axis=1)
+    vec = np.take_along_axis(vec, order[:, None, :], axis=2)
+    weight = np.concatenate([m_diag, m_diag], axis=1)
+    for r in range(lam.shape[0]):
+        sort = np.lexsort((lam[r, :k].real, lam[r, :k].imag))
+        lam[r, :k] = lam[r, :k][sort]
+        vec[r, :, :k] = _canonical_repeated(lam[r, :k], vec[r, :, :k][:, sort], weight[r])
+    lb, vb = track_modes(lam[:, :k], vec[:, :, :k])
+    li, vi = track_modes(lam[:, k:], vec[:, :, k:])
+    return np.concatenate([lb, li], axis=1), np.concatenate([vb, vi], axis=2)
 
 
 def matching_order(ref: NDArray[np.complex128], lam: NDArray[np.complex128]) -> NDArray[np.int64] | None:
@@ -393,8 +483,13 @@ def matching_order(ref: NDArray[np.complex128], lam: NDArray[np.complex128]) -> 
     return perm
 
 
-def _conjugate_groups(lam: NDArray[np.complex128]) -> list[NDArray[np.int64]]:
-    """Columns of a tracked set that form one mode: linked where one is the conjugate of another."""
+def _conjugate_groups(lam: NDArray[np.complex128], vectors: NDArray | None = None) -> list[NDArray[np.int64]]:
+    """Columns of a tracked set that form one mode: linked where one is the conjugate of another.
+
+    ``vectors (rows, S, k)``: where several columns hold the conjugate value (identical planes that
+    one group of dofs carries), the partner is the one whose eigenvector is the conjugate of the
+    column's own (largest MAC), not the first of them.
+    """
     k = lam.shape[1]
     label = np.arange(k)
 
@@ -408,6 +503,14 @@ def _conjugate_groups(lam: NDArray[np.complex128]) -> list[NDArray[np.int64]]:
         dist = np.abs(lam[:, :, None] - np.conj(lam)[:, None, :])  # (rows, a, b)
         partner = np.argmin(np.where(np.isnan(dist), np.inf, dist), axis=-1)
         near = np.take_along_axis(dist, partner[..., None], axis=-1)[..., 0] <= _PAIR_TOL * scale
+        if vectors is not None:
+            from .tracking import mac
+
+            for r in range(lam.shape[0]):
+                cand = dist[r] <= _PAIR_TOL * scale                      # (a, b)
+                if (cand.sum(axis=1) > 1).any():
+                    fit = np.where(cand, mac(np.conj(vectors[r]), vectors[r]), -1.0)
+                    partner[r] = np.argmax(fit, axis=1)
         upper = lam.imag > _PAIR_TOL * scale
     first = np.broadcast_to(np.arange(k), partner.shape)
     linked = upper & near & (partner != first)

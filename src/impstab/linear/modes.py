@@ -45,7 +45,16 @@ class ModalResult:
         Displacement shapes at A (m, rad), largest component 1.
     participation : (k, 6)
         The mode decoupling table: kinetic-energy share of each dof in each mode, in the
-        coordinates of the mass centre (rows sum to 1; see the module notes).
+        coordinates of the mass centre (rows sum to 1; see the module notes). With massive beam
+        mounts: the body's part of the energy split over its dofs (rows sum to 1).
+    internal_share : (k,) array or None
+        With massive beam mounts (:mod:`impstab.linear.mount_dofs`): the share of each mode's
+        kinetic energy in the mounts' internal (fixed-interface) dofs; above 1/2 the mode is an
+        internal mount mode (:attr:`kind`). None without such mounts.
+    mount_elements : tuple of int
+        Finite elements of each massive beam mount (empty without them).
+    internal_dofs : int
+        Internal dofs carried (Craig-Bampton modes kept below the cutoff).
     """
 
     thrust: float
@@ -53,6 +62,17 @@ class ModalResult:
     eigenvalues: NDArray[np.complex128]
     shapes: NDArray[np.complex128]
     participation: NDArray[np.float64]
+    internal_share: NDArray[np.float64] | None = None
+    mount_elements: tuple[int, ...] = ()
+    internal_dofs: int = 0
+
+    @property
+    def kind(self) -> list[str]:
+        """``"body"`` or ``"mount"`` (an internal mount mode: most kinetic energy in the mounts'
+        internal dofs) for each mode."""
+        if self.internal_share is None:
+            return ["body"] * len(self.eigenvalues)
+        return ["mount" if s > 0.5 else "body" for s in self.internal_share]
 
     def __repr__(self) -> str:
         from ..display import modal_text
@@ -104,6 +124,16 @@ class ModalResult:
         return {n: (100.0 * self.participation[:, j]).tolist() for j, n in enumerate(DOF_NAMES)}
 
     def to_dict(self) -> dict:
+        out = self._to_dict()
+        if self.internal_share is not None:
+            out["mount_elements"] = list(self.mount_elements)
+            out["internal_dofs"] = self.internal_dofs
+            for j, row in enumerate(out["modes"]):
+                row["kind"] = self.kind[j]
+                row["internal_energy_share"] = float(self.internal_share[j])
+        return out
+
+    def _to_dict(self) -> dict:
         return {
             "thrust": self.thrust,
             "linearization": self.linearization,
@@ -127,8 +157,14 @@ class ModalResult:
 
         from .. import __version__
 
+        extra = {}
+        if self.internal_share is not None:
+            extra = {"internal_share": ("mode", self.internal_share, {
+                         "units": "1", "long_name": "kinetic-energy share of the beam mounts' internal dofs"}),
+                     "kind": ("mode", self.kind, {"long_name": "body or mount (internal mount mode)"})}
         return xr.Dataset(
             {
+                **extra,
                 "omega": ("mode", self.omega, {"units": "rad/s"}),
                 "frequency_hz": ("mode", self.frequency_hz, {"units": "Hz"}),
                 "growth_rate": ("mode", self.growth_rate, {"units": "1/s"}),
@@ -248,9 +284,8 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
     With compressible fluid loading each mode is computed with the added mass and radiation
     damping at its own frequency, iterated to consistency (fixed point on the frequency).
     """
-    from .mount_dofs import refuse_massive_beams
-
-    refuse_massive_beams(model, "the modal analysis")
+    if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: the grown system
+        return _grown_modes(model, thrust, linearization)
     if model.is_viscoelastic:  # internal variables: the augmented first-order system
         from .viscoelastic import viscoelastic_modes
 
@@ -304,3 +339,47 @@ def _fluid_consistent(model: Model, thrust: float, linearization: str | None, ba
 #: relative change of a mode's frequency that ends the fluid fixed point; modes whose frequencies
 #: agree to it share one eigenproblem
 FREQUENCY_TOLERANCE = 1e-12
+
+
+def _grown_modes(model: Model, thrust: float, linearization: str | None) -> ModalResult:
+    """Modes of the body with the internal dofs of its massive beam mounts
+    (:mod:`impstab.linear.mount_dofs`): every eigenvalue of the grown system with ``omega >= 0``;
+    shapes and the decoupling table of the body dofs, the internal share of each mode's kinetic
+    energy beside them."""
+    from ..errors import ModelError, NumericalError
+    from .linearize import ModelFamily
+
+    if model.fluid.compressible:
+        raise ModelError("fluid.sound_speed", model.fluid.sound_speed,
+                         "the modes of a model with beam mounts with mass take the fluid incompressible only: "
+                         "leave sound_speed out (or use density = 0 for the massless beams)")
+    fam = ModelFamily(model, linearization)
+    m, d, g, k = (np.asarray(a[0], dtype=float) for a in fam.matrices(np.array([float(thrust)])))
+    if not np.isfinite(k).all():
+        raise NumericalError(f"no static equilibrium found at thrust {thrust:.6g} N: the mounts cannot carry this thrust")
+    n = m.shape[0]
+    if not (np.any(d) or np.any(g)):
+        vals, vecs = _undamped_eigenpairs(LinearSystem(m, d, g, k, float(thrust), fam.linearization, np.zeros(3), np.eye(3)))
+    else:
+        mk = np.linalg.solve(m, np.hstack([k, d + g]))
+        a = np.block([[np.zeros((n, n)), np.eye(n)], [-mk[:, :n], -mk[:, n:]]])
+        vals, vecs = np.linalg.eig(a)
+        scale = max(np.abs(vals).max(), 1e-300)
+        keep = (vals.imag > 1e-12 * scale) | (np.abs(vals.imag) <= 1e-12 * scale)
+        vals, vecs = vals[keep], vecs[:n, keep]
+    vals, vecs = np.asarray(vals, dtype=complex), np.asarray(vecs, dtype=complex)
+    order = np.lexsort((vals.real, np.abs(vals.imag)))
+    vals, vecs = vals[order], vecs[:, order]
+    vecs = _canonical_repeated(vals, vecs, np.diag(m))
+    energy = (vecs.conj() * (m @ vecs)).real                     # (n, k)
+    total = energy.sum(axis=0)
+    internal = energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0)
+    body = vecs[:6]
+    big = np.argmax(np.abs(body), axis=0)
+    piv = body[big, np.arange(body.shape[1])]
+    shapes = body / np.where(piv != 0, piv, 1.0)
+    part = energy_shares(shapes, m[:6, :6])
+    beams = [mt.beam for mt in model.mounts if mt.is_massive_beam]
+    return ModalResult(float(thrust), fam.linearization, vals, shapes, part,  # type: ignore[arg-type]
+                       internal_share=internal, mount_elements=tuple(int(b.elements) for b in beams),
+                       internal_dofs=n - 6)

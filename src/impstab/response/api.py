@@ -21,7 +21,8 @@ from ..linear.modes import modes
 from ..linear.system import LinearSystem
 from ..model.foundation import Foundation
 from ..model.model import DOF_NAMES, Model
-from .core import harmonic_response
+from ..model.beam_dynamic import LOST_DIGITS_WARNING
+from .core import HarmonicSolution, harmonic_response
 from .excitation import excitation_lines, shaft_rate, unit_load
 from .fluid import fluid_dynamic_stiffness, fluid_spectrum
 from .result import ForcedResponse
@@ -97,6 +98,9 @@ class DesignInputs:
     viscoelastic : Model or None
         The model, when its mounts follow viscoelastic laws: their exact complex stiffness is then
         applied at each frequency (such a design is solved on its own).
+    beams : tuple of (int, BeamMount, axis)
+        The beam mounts with mass: each is its exact dynamic stiffness at every frequency
+        (:mod:`impstab.response.beam`; such a design is solved on its own).
     """
 
     linear: LinearSystem
@@ -107,6 +111,12 @@ class DesignInputs:
     hull: NDArray | None
     settings: dict
     viscoelastic: Model | None = None
+    beams: tuple = ()
+
+    @property
+    def alone(self) -> bool:
+        """True when the design's mounts change with frequency (solved on its own)."""
+        return self.viscoelastic is not None or bool(self.beams)
 
 
 def design_inputs(model: Model, f: NDArray, thrust: float, linearization: str | None = None,
@@ -116,9 +126,6 @@ def design_inputs(model: Model, f: NDArray, thrust: float, linearization: str | 
     The single route from a model to the stacked arrays of :func:`harmonic_response`, used by
     :func:`frequency_response` (one design) and by design studies (many designs in one solve).
     """
-    from ..linear.mount_dofs import refuse_massive_beams
-
-    refuse_massive_beams(model, "the forced response")
     lin = linearize(model, thrust, linearization)
     settings: dict = {}
     fluid_extra = None
@@ -138,13 +145,26 @@ def design_inputs(model: Model, f: NDArray, thrust: float, linearization: str | 
     if model.is_viscoelastic:  # the exact complex stiffness k*(omega) of each mount at each frequency
         viscoelastic = model
         settings["mounts"] = "viscoelastic: the exact complex stiffness of each law at every frequency"
+    beams = tuple((i, m.beam, m.axis) for i, m in enumerate(model.mounts) if m.is_massive_beam)
+    if beams:
+        from .beam import beam_lost_digits
+
+        lost = beam_lost_digits(beams, 2.0 * np.pi * f)
+        settings["mounts"] = (
+            "beam mounts with mass: the exact dynamic stiffness of the continuous Timoshenko beam at every "
+            f"frequency (transfer matrix, undamped material, up to {lost:.1f} digits lost to evanescent waves); "
+            "hull force at the hull end of each beam")
+        if lost > LOST_DIGITS_WARNING:
+            settings["beam_warning"] = (
+                f"the beam mounts' transfer matrices lose up to {lost:.1f} digits at the highest frequencies "
+                "(evanescent bending waves over a long beam): the response there is inaccurate")
     return DesignInputs(
         linear=lin,
         positions=np.array([m.position for m in model.mounts], dtype=float).reshape(-1, 3),
         mount_stiffness=np.array([m.stiffness for m in model.mounts], dtype=float).reshape(-1, 6, 6),
         mount_damping=np.array([m.damping for m in model.mounts], dtype=float).reshape(-1, 6, 6),
         fluid=fluid_extra, hull=None if hull is None else hull[0], settings=settings,
-        viscoelastic=viscoelastic,
+        viscoelastic=viscoelastic, beams=beams,
     )
 
 
@@ -163,15 +183,26 @@ def solve_designs(designs: Sequence[DesignInputs], f: NDArray, loads: NDArray):
     hull = None
     if any(d.hull is not None for d in designs):
         hull = np.stack([np.full((f.size, nm), np.inf, complex) if d.hull is None else d.hull for d in designs])
+    if len(designs) > 1 and any(d.alone for d in designs):  # frequency-dependent mounts: one by one
+        loads = np.asarray(loads, dtype=complex)
+        parts = [solve_designs([d], f, loads[j:j + 1] if loads.ndim == 3 and loads.shape[0] > 1 else loads)
+                 for j, d in enumerate(designs)]
+        return HarmonicSolution(omega=parts[0].omega, **{
+            name: np.concatenate([getattr(p, name) for p in parts], axis=0)
+            for name in HarmonicSolution.__dataclass_fields__ if name != "omega"})
     respond = harmonic_response
     if designs[0].viscoelastic is not None:
-        if len(designs) != 1:
-            raise ValueError("a design with viscoelastic mounts is solved on its own")
         from functools import partial
 
         from .viscoelastic import viscoelastic_harmonic_response
 
         respond = partial(viscoelastic_harmonic_response, designs[0].viscoelastic)
+    elif designs[0].beams:
+        from functools import partial
+
+        from .beam import beam_harmonic_response
+
+        respond = partial(beam_harmonic_response, designs[0].beams)
     return respond(
         lin("M"), lin("D"), lin("G"), lin("K"), lin("rotation"), stack("positions"), stack("mount_stiffness"),
         stack("mount_damping"), 2.0 * np.pi * f, loads, fluid=fluid, foundation=hull,
@@ -186,7 +217,15 @@ def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearizat
     settings: dict = {"model": model.name, "model_source": model.source or "", **inputs.settings}
     sol = solve_designs([inputs], f, loads[None])
     md = modes(model, thrust, linearization)
+    body = np.array([kind == "body" for kind in md.kind], dtype=bool)
+    if not body.all():  # massive beam mounts: their internal modes are counted, not listed
+        internal = md.frequency_hz[~body]
+        settings["internal_mount_modes"] = (
+            f"{internal.size} internal modes of the beam mounts (finite elements {', '.join(map(str, md.mount_elements))}"
+            f" per beam), the lowest at {internal.min():.6g} Hz: peaks of the exact response, not listed below")
     warnings: list[str] = []
+    if "beam_warning" in settings:
+        warnings.append(settings.pop("beam_warning"))
     if not md.stable:
         j = int(np.argmax(md.growth_rate))
         warnings.append(
@@ -208,8 +247,9 @@ def _respond(model: Model, f: NDArray, loads: NDArray, thrust: float, linearizat
         hull_force=sol.hull_force[0], power_input=sol.power_input[0], power_thrust=sol.power_thrust[0],
         power_fluid=sol.power_fluid[0], power_damper=sol.power_damper[0], power_transmitted=sol.power_transmitted[0],
         pivot_ratio=sol.pivot_ratio[0], thrust=float(thrust), linearization=lin.linearization, input=input_name,
-        shaft_rate=shaft_rate(model, thrust), source=source, mode_frequency_hz=md.frequency_hz,
-        mode_growth_rate=md.growth_rate, mode_dominant=tuple("/".join(d) for d in md.dominant()), settings=settings, warnings=tuple(warnings),
+        shaft_rate=shaft_rate(model, thrust), source=source, mode_frequency_hz=md.frequency_hz[body],
+        mode_growth_rate=md.growth_rate[body], mode_dominant=tuple("/".join(d) for j, d in enumerate(md.dominant()) if body[j]),
+        settings=settings, warnings=tuple(warnings),
     )
 
 

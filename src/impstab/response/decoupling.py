@@ -182,7 +182,8 @@ def decoupling_check(model: Model, thrust: float | None = None, linearization: s
     tra_point = np.cross(alpha, a_a) / (alpha @ alpha)
     # roll mode and its rotation axis
     roll = DOF_NAMES.index("roll")
-    j = int(np.argmax(md.participation[:, roll]))
+    body = np.array([kind == "body" for kind in md.kind])  # massive beam mounts: not an internal mode
+    j = int(np.argmax(np.where(body, md.participation[:, roll], -np.inf)))
     x = md.shapes[:, j]
     x = (x * np.conj(x[roll]) / abs(x[roll])).real if abs(x[roll]) > 0 else x.real
     theta, u = x[3:], x[:3]
