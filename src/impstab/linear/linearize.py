@@ -234,6 +234,16 @@ class ModelFamily:
     def packed(self) -> PackedModel:
         return self._packed  # type: ignore[attr-defined]
 
+    @property
+    def undamped_nongyroscopic(self) -> bool:
+        """True when D and G vanish at every thrust by construction: no mount damper, no fluid
+        radiation damping, no spinning propeller inertia, no internal mount dofs. The engine then
+        takes the undamped form without sampling D and G (which needs static equilibria at the
+        far end of the search range, the costliest poses to reach)."""
+        pk = self.packed
+        return (self._internal is None and not np.any(pk.damp6) and not np.any(pk.damping)  # type: ignore[attr-defined]
+                and pk.polar_inertia * pk.speed == 0.0)
+
     def evaluate(self, thrusts: Array, strict: bool = True):
         """``M, D, G, K`` stacks and the static poses ``u0, R0`` at each thrust.
 

@@ -200,7 +200,8 @@ def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: in
     """The problem of a second-order family ``p -> (M, D, G, K)`` (:class:`~impstab.linear.SystemFamily`).
 
     ``undamped`` forces the undamped (``s``) or the first-order form; by default the undamped form
-    is used where D and G vanish (affine families: exactly; others: at ``p_min``, the middle and
+    is used where D and G vanish (affine families: exactly; families that say so by
+    ``undamped_nongyroscopic = True``: by their structure; others: at ``p_min``, the middle and
     ``p_max``, since damping and gyroscopic terms may follow the load).
     """
     p_min, p_max, n_scan = _range(family, p_min, p_max, n_scan)
@@ -208,6 +209,8 @@ def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: in
     if parts is not None:
         parts = [np.asarray(x, dtype=float) for x in parts]
         d, g = parts[1], parts[2]
+    elif getattr(family, "undamped_nongyroscopic", False):
+        d = g = np.zeros((1, 1))  # the family's structure: no damper and no gyroscopic term at any load
     else:
         _, d, g, _ = family.matrices(np.array([p_min, 0.5 * (p_min + p_max), p_max]))
         # a load without a static equilibrium gives NaN matrices: they say nothing about damping
