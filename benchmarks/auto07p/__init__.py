@@ -5,11 +5,12 @@ of ``u' = f(u, par)`` written as a Fortran subroutine ``FUNC``. :func:`transcrib
 file for an impstab model with the model's numbers baked in: the same 12 states as
 :class:`impstab.dynamics.system.NonlinearSystem` (position of A, z-y-x Euler angles, body-frame
 velocities), the same equations as :func:`impstab.dynamics.rhs.model_rhs` line by line (mounts
-with 3 x 3 translational stiffness and damping and their cubic axial and shear laws, follower and
-fixed thrust, propeller gyroscopic moment, Newton-Euler Coriolis terms, fluid radiation damping,
-``nu' = M^-1 tau``), and the thrust in kN as ``PAR(1)`` (so that the parameter and the states
-weigh alike in AUTO's unscaled arclength). Mounts with rotational stiffness and snubbers are
-not transcribed (refused with a ValueError).
+with 3 x 3 translational stiffness and damping, their cubic axial and shear laws and snubbers
+with the smoothed ramp, follower and fixed thrust, propeller gyroscopic moment, Newton-Euler
+Coriolis terms, fluid radiation damping, ``nu' = M^-1 tau``), and the thrust in kN as
+``PAR(1)`` (so that the parameter and the states weigh alike in AUTO's unscaled arclength).
+Mounts with rotational stiffness (6 x 6 mounts, beam mounts) are not transcribed (refused with
+a ValueError).
 
 :func:`run_branch` compiles it (gfortran, linked against AUTO's library objects as AUTO's own
 ``@r`` makefile does) and runs AUTO's executable directly, without its Python front end:
@@ -41,12 +42,16 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["AUTO_DIR", "available", "transcribe", "run_branch", "AutoBranch", "read_solutions", "KN"]
+__all__ = ["AUTO_DIR", "available", "transcribe", "compile_model", "hopf_point", "run_branch", "AutoBranch",
+           "read_solutions", "amplitude", "KN"]
 
 #: AUTO-07p's installation (Debian: /usr/lib/auto-07p)
 AUTO_DIR = Path(os.environ.get("AUTO_DIR", "/usr/lib/auto-07p"))
 #: thrust unit of PAR(1) (N)
 KN = 1000.0
+#: OpenMP threads of AUTO's runs: one (on a loaded two-core machine two threads ran 2.5 times
+#: slower in wall-clock time, measured)
+THREADS = 1
 
 
 def available() -> str | None:
@@ -82,14 +87,13 @@ def transcribe(model) -> str:
     """
     from impstab.dynamics.rhs import (FLAG_ROTATION, P_CG, P_E, P_IA, P_JP, P_MASS, P_RADIATION, P_RT, P_TANG)
     from impstab.dynamics.system import NonlinearSystem
-    from impstab.model.mount_law import LAW_AXIS, LAW_CLEARANCE, LAW_K3_AXIAL, LAW_K3_SHEAR
+    from impstab.model.mount_law import (LAW_AXIS, LAW_CLEARANCE, LAW_K3_AXIAL, LAW_K3_SHEAR, LAW_SNUBBER,
+                                         SNUBBER_SMOOTHING)
 
     ns = NonlinearSystem(model)
     pos, kmat, cmat, flags, laws, par, minv, damp6 = ns.system.arrays[:8]
     if np.any(flags & FLAG_ROTATION):
         raise ValueError("mounts with rotational stiffness or damping are not transcribed to AUTO-07p")
-    if laws.size and np.any(laws[:, LAW_CLEARANCE] > 0.0):
-        raise ValueError("snubbers are not transcribed to AUTO-07p")
     nm = pos.shape[0]
     if laws.size == 0:
         laws = np.zeros((nm, 7))
@@ -107,6 +111,9 @@ def transcribe(model) -> str:
     src.append(_array("AX", laws[:, LAW_AXIS:LAW_AXIS + 3].T, (3, nm)))
     src.append(_array("K3A", laws[:, LAW_K3_AXIAL], (nm,)))
     src.append(_array("K3S", laws[:, LAW_K3_SHEAR], (nm,)))
+    src.append(_array("CLR", laws[:, LAW_CLEARANCE], (nm,)))
+    src.append(_array("KSN", laws[:, LAW_SNUBBER], (nm,)))
+    src.append(f"  DOUBLE PRECISION, PARAMETER :: SMOOTH = {_f(SNUBBER_SMOOTHING)}\n")
     src.append(_array("MINV", minv, (6, 6)))
     src.append(_array("D6", damp6, (6, 6)))
     src.append(_array("IA", par[P_IA:P_IA + 9].reshape(3, 3), (3, 3)))
@@ -141,6 +148,7 @@ SUBROUTINE FUNC(NDIM, U, ICP, PAR, IJAC, F, DFDU, DFDP)
   DOUBLE PRECISION :: T, R(3, 3), CF, SF, CT, ST, CP, SP, TT, X(3), VB(3), WB(3), VH(3), WH(3)
   DOUBLE PRECISION :: FH(3), MH(3), RHO(3), D(3), DD(3), G(3), C(3), DA, S(3), CA, CS, L(3)
   DOUBLE PRECISION :: RE(3), TH(3), RTH(3), TAU(6), H(3), WV(3), WG(3), WWG(3), IW(3), NU(6)
+  DOUBLE PRECISION :: R2, RR, WW, TS, RAMP
   INTEGER :: I
   T = PAR(1) * 1000.0d0
   X = U(1:3)
@@ -181,6 +189,21 @@ SUBROUTINE FUNC(NDIM, U, ICP, PAR, IJAC, F, DFDU, DFDP)
     CA = K3A(I) * DA**3
     CS = K3S(I) * DOT_PRODUCT(S, S)
     G = G + CA * AX(:, I) + CS * S
+    IF (CLR(I) > 0.0d0) THEN
+      ! snubber: k_snub ramp(|d| - c) d / |d|, the ramp C2-smoothed over SMOOTH c
+      R2 = DOT_PRODUCT(D, D)
+      IF (R2 > CLR(I)**2) THEN
+        RR = SQRT(R2)
+        WW = SMOOTH * CLR(I)
+        TS = (RR - CLR(I)) / WW
+        IF (TS < 1.0d0) THEN
+          RAMP = WW * TS**3 * (1.0d0 - 0.5d0 * TS)
+        ELSE
+          RAMP = RR - CLR(I) - 0.5d0 * WW
+        END IF
+        G = G + KSN(I) * RAMP / RR * D
+      END IF
+    END IF
     L = -G
     CALL CROSS(RHO, L, C)
     FH = FH + L
@@ -316,60 +339,78 @@ def _constants(**kw) -> str:
 def _run(exe: Path, work: Path, constants: str) -> tuple[str, float]:
     (work / "fort.2").write_text(constants)
     t0 = time.perf_counter()
-    proc = subprocess.run([str(exe)], cwd=work, capture_output=True, text=True, timeout=600)
+    env = dict(os.environ, OMP_NUM_THREADS=str(THREADS))
+    proc = subprocess.run([str(exe)], cwd=work, capture_output=True, text=True, timeout=600, env=env)
     dt = time.perf_counter() - t0
     if proc.returncode != 0:
         raise RuntimeError(f"AUTO-07p run failed ({proc.returncode}): {proc.stdout[-2000:]} {proc.stderr[-2000:]}")
     return proc.stdout, dt
 
 
-def run_branch(model, thrusts, thrust_max: float, *, ntst: int = 40, ncol: int = 4, ds: float = 0.01,
-               ds_max: float = 0.05, tolerance: float = 1e-10, max_points: int = 2000,
-               workdir: Path | None = None) -> AutoBranch:
-    """AUTO-07p's equilibria to the Hopf point and its periodic orbits through ``thrusts`` (N).
-
-    ``ds``, ``ds_max`` are AUTO's arclength steps (in its unscaled norm, thrust in kN);
-    ``tolerance`` is its Newton tolerance on the states and the parameter (EPSU, EPSL). The last
-    thrust ends the run.
-    """
+def compile_model(model, work: Path) -> tuple[Path, float]:
+    """Write ``model``'s equations file into ``work`` and build AUTO's executable from it, as
+    AUTO's ``@r`` makefile does; returns the executable and the seconds it took."""
     why = available()
     if why:
         raise RuntimeError(why)
+    work = Path(work)
+    (work / "prop.f90").write_text(transcribe(model))
+    libs = sorted(str(p) for p in (AUTO_DIR / "lib").glob("*.o"))
+    t0 = time.perf_counter()
+    for cmd in (["gfortran", "-O2", "-fopenmp", "-c", "prop.f90", "-o", "prop.o"],
+                ["gfortran", "-O2", "-fopenmp", "prop.o", "-o", "prop.exe", *libs]):
+        proc = subprocess.run(cmd, cwd=work, capture_output=True, text=True, timeout=300)
+        if proc.returncode != 0:
+            raise RuntimeError(f"compiling the AUTO-07p equations failed: {proc.stderr[-2000:]}")
+    return work / "prop.exe", time.perf_counter() - t0
+
+
+def _common(tolerance: float, location_tolerance: float) -> dict:
+    return dict(NDIM=12, ILP=1, NBC=0, NINT=0, ISW=1, IPLT=0, MXBF=10, IID=2, ITMX=20, ITNW=7, NWTN=3,
+                JAC=0, EPSL=float(tolerance), EPSU=float(tolerance), EPSS=float(location_tolerance))
+
+
+def hopf_point(exe: Path, work: Path, thrust_max: float, *, tolerance: float = 1e-10,
+               location_tolerance: float = 1e-9) -> tuple[Solution, float, str]:
+    """AUTO's equilibria from the unloaded state ``u = 0`` at ``T = 0`` up in thrust (``IPS = 1``)
+    to the first Hopf point it detects (``STOP = ['HB1']``); returns that solution (``PAR(1)``
+    in kN, ``PAR(11)`` the period at the onset), the seconds and AUTO's log. Its solution file
+    stays in ``work/fort.8``."""
+    log, seconds = _run(exe, work, _constants(
+        IPS=1, IRS=0, ICP="[1]", NTST=10, NCOL=4, IAD=3, ISP=1, NMX=500, NPR=1000, DS=0.2,
+        DSMIN=1e-6, DSMAX=0.5, IADS=1, RL0=-0.1, RL1=float(thrust_max) / KN, A0=0.0, A1=1e3, STOP="['HB1']",
+        **_common(tolerance, location_tolerance)))
+    hb = [s for s in read_solutions(Path(work) / "fort.8") if s.kind == 3]
+    if not hb:
+        raise RuntimeError("AUTO-07p found no Hopf point on the equilibrium branch:\n" + log[-2000:])
+    return hb[0], seconds, log
+
+
+def run_branch(model, thrusts, thrust_max: float, *, ntst: int = 40, ncol: int = 4, ds: float = 0.01,
+               ds_max: float = 0.05, tolerance: float = 1e-10, location_tolerance: float = 1e-9,
+               max_points: int = 2000, workdir: Path | None = None) -> AutoBranch:
+    """AUTO-07p's equilibria to the Hopf point and its periodic orbits through ``thrusts`` (N).
+
+    ``ds``, ``ds_max`` are AUTO's arclength steps (in its unscaled norm, thrust in kN);
+    ``tolerance`` is its Newton tolerance on the states and the parameter (EPSU, EPSL);
+    ``location_tolerance`` (EPSS) that of its special and user points (with AUTO's default 1e-6 a
+    requested thrust is located to some 1e-5 N, an amplitude error of 5e-8 near the onset). The
+    last thrust ends the run. JAC = 0: AUTO differentiates ``FUNC`` by finite differences.
+    """
     thrusts = np.sort(np.asarray(thrusts, dtype=float))
     own = workdir is None
     work = Path(tempfile.mkdtemp(prefix="impstab-auto07p-")) if own else Path(workdir)
     try:
-        src = work / "prop.f90"
-        src.write_text(transcribe(model))
-        libs = sorted(str(p) for p in (AUTO_DIR / "lib").glob("*.o"))
-        t0 = time.perf_counter()
-        for cmd in (["gfortran", "-O2", "-fopenmp", "-c", "prop.f90", "-o", "prop.o"],
-                    ["gfortran", "-O2", "-fopenmp", "prop.o", "-o", "prop.exe", *libs]):
-            proc = subprocess.run(cmd, cwd=work, capture_output=True, text=True, timeout=300)
-            if proc.returncode != 0:
-                raise RuntimeError(f"compiling the AUTO-07p equations failed: {proc.stderr[-2000:]}")
-        t_compile = time.perf_counter() - t0
-        exe = work / "prop.exe"
-        common = dict(NDIM=12, ILP=1, NBC=0, NINT=0, ISW=1, IPLT=0, MXBF=10, IID=2, ITMX=8, ITNW=7, NWTN=3,
-                      JAC=0, EPSL=float(tolerance), EPSU=float(tolerance), EPSS=1e-6)
-        # 1. equilibria from the unloaded state up to the Hopf point
-        top = float(thrust_max) / KN
-        log1, t1 = _run(exe, work, _constants(
-            IPS=1, IRS=0, ICP="[1]", NTST=ntst, NCOL=ncol, IAD=3, ISP=1, NMX=500, NPR=1000, DS=0.2,
-            DSMIN=1e-6, DSMAX=0.5, IADS=1, RL0=-0.1, RL1=top, A0=0.0, A1=1e3, STOP="['HB1']", **common))
-        sols = read_solutions(work / "fort.8")
-        hb = [s for s in sols if s.kind == 3]
-        if not hb:
-            raise RuntimeError("AUTO-07p found no Hopf point on the equilibrium branch:\n" + log1[-2000:])
-        hb = hb[0]
+        exe, t_compile = compile_model(model, work)
+        hb, t1, log1 = hopf_point(exe, work, thrust_max, tolerance=tolerance, location_tolerance=location_tolerance)
         shutil.copy(work / "fort.8", work / "fort.3")
-        # 2. periodic orbits from the Hopf point through the requested thrusts
+        # periodic orbits from the Hopf point through the requested thrusts
         uzr = ", ".join(repr(float(t) / KN) for t in thrusts[:-1])
         log2, t2 = _run(exe, work, _constants(
             IPS=2, IRS=hb.label, ICP="[1, 11]", NTST=ntst, NCOL=ncol, IAD=3, ISP=2, NMX=int(max_points),
-            NPR=100000, DS=float(ds), DSMIN=1e-8, DSMAX=float(ds_max), IADS=1, RL0=0.0, RL1=top * 1.01,
-            A0=0.0, A1=1e3, UZR="{1: [" + uzr + "]}", UZSTOP="{1: " + repr(float(thrusts[-1]) / KN) + "}",
-            **common))
+            NPR=100000, DS=float(ds), DSMIN=1e-8, DSMAX=float(ds_max), IADS=1, RL0=0.0,
+            RL1=float(thrust_max) / KN * 1.01, A0=0.0, A1=1e3, UZR="{1: [" + uzr + "]}",
+            UZSTOP="{1: " + repr(float(thrusts[-1]) / KN) + "}", **_common(tolerance, location_tolerance)))
         orbits = [s for s in read_solutions(work / "fort.8") if s.kind in (4, -4, 9, -9)]
         found = []
         for t in thrusts:
