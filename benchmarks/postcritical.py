@@ -34,8 +34,11 @@ reports it; errors are relative, per coordinate, the largest over the six and th
   periodic orbits from HB over the same thrusts (orthogonal collocation NCOL = 4 like impstab's
   degree 4, adaptive mesh IAD = 3, Floquet multipliers ISP = 2, the fifty thrusts located as
   user points UZR, Newton tolerances EPSL = EPSU = 1e-10, EPSS = 1e-9, finite-difference Jacobian
-  JAC = 0, one OpenMP thread). NTST is the smallest of 10, 20, 40, 80 whose amplitude error
-  reaches the impstab branch's; its time includes the compilation (reported also without).
+  JAC = 0, one OpenMP thread). NTST is the smallest of 10, 20, 30, 40, 50, 60, 80 whose
+  amplitude error reaches the impstab branch's; its time includes the compilation of the
+  equations file (reported also without).
+
+The two quick methods are timed as the best of two runs, the baseline once (it runs minutes).
 
 Run: ``python benchmarks/postcritical.py``; ends with one JSON line. Timings on a shared machine
 are noisy: compare ratios of one run.
@@ -69,7 +72,9 @@ REFERENCE_REFINEMENT = 4
 STEP_DIVISOR = 8
 #: floor of the baseline's tolerance (the integrator's own error at that step)
 TOL_FLOOR = 5e-9
-AUTO_NTST = (10, 20, 40, 80)
+AUTO_NTST = (10, 20, 30, 40, 50, 60, 80)
+#: timed runs of the two quick methods (the best is kept: the machine is shared)
+REPEATS = 2
 
 
 def _at(res, thrusts):
@@ -93,9 +98,11 @@ def main() -> None:
     settle_sweep(model, thrusts[-1:], tolerance=1e-3, period=2 * math.pi / crit.omega,
                  step=default_step(model, t_top), max_cycles=50)
 
-    t0 = time.perf_counter()
-    res = propulsor_postcritical(model, thrust_max=t_top, thrusts=thrusts.tolist(), max_points=200)
-    t_branch = time.perf_counter() - t0
+    t_branch = math.inf
+    for _ in range(REPEATS):
+        t0 = time.perf_counter()
+        res = propulsor_postcritical(model, thrust_max=t_top, thrusts=thrusts.tolist(), max_points=200)
+        t_branch = min(t_branch, time.perf_counter() - t0)
     pc_amp, pc_per, _ = _at(res, thrusts)
     trivial = float(np.nanmax(res.trivial_multiplier_error))
     print(f"impstab branch: {res.branch_thrust.size} cycles ({POINTS} requested), Floquet multipliers of each, "
@@ -138,7 +145,7 @@ def main() -> None:
             auto_rows.append((b, err))
             print(f"AUTO-07p NTST = {ntst:3d}, NCOL = 4: {b.points} points, {b.seconds:.2f} s "
                   f"({b.compile_seconds:.2f} s compiling, {b.run_seconds:.2f} s running); error {err.max():.2e}")
-            if err.max() <= pc_err.max() * 1.05:
+            if err.max() <= pc_err.max():
                 auto = (b, err)
                 break
         if auto is None and auto_rows:
@@ -146,10 +153,17 @@ def main() -> None:
             print("AUTO-07p did not reach the impstab branch's accuracy; its most accurate run is compared")
     else:
         print(f"AUTO-07p: skipped: {why}")
+    if auto is not None:
+        for _ in range(REPEATS - 1):
+            again = auto07p.run_branch(model, thrusts, t_top, ntst=auto[0].ntst, ncol=4)
+            if again.seconds < auto[0].seconds:
+                auto = (again, rel_err(again.amplitude[:, :6], ref_amp))
+        print(f"AUTO-07p timed: NTST = {auto[0].ntst}, best of {REPEATS} runs {auto[0].seconds:.2f} s "
+              f"({auto[0].run_seconds:.2f} s without compiling)")
 
     print(f"{'thrust (N)':>12} {'pitch amp (rad)':>16} {'period (s)':>12} {'impstab err':>12} "
           f"{'time int. err':>14} {'AUTO err':>10}")
-    for k in list(range(0, POINTS, 7)) + [POINTS - 1]:
+    for k in sorted(set(range(0, POINTS, 7)) | {POINTS - 1}):
         a_err = f"{auto[1][k].max():10.1e}" if auto else f"{'-':>10}"
         print(f"{thrusts[k]:12.2f} {ref_amp[k, 4]:16.10g} {ref_per[k]:12.9f} {pc_err[k].max():12.1e} "
               f"{bf_err[k].max():14.1e} {a_err}")
