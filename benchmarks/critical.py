@@ -58,6 +58,9 @@ import scipy.linalg as sla
 from scipy.optimize import brentq
 
 import impstab
+from impstab._jit import require_compiled
+
+require_compiled()  # the kernels are what is timed here (a lone call in a fresh process runs them interpreted)
 from impstab.linear.linearize import ModelFamily
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

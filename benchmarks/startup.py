@@ -7,14 +7,18 @@ impstab, each in a fresh process (median of ``--repeat`` runs; wall time and the
 user + sys, which a loaded machine disturbs less):
 
 * ``impstab --version``, ``impstab --help``;
-* ``impstab critical examples/imp_symmetric.toml --json``, warm (its kernels in the cache);
+* ``impstab critical examples/imp_symmetric.toml --json``, warm (its kernels in the cache), and
+  the same with ``IMPSTAB_JIT=compiled`` (numba imported and the kernels loaded from the cache,
+  which is what every run paid before single-model analyses ran their kernels interpreted, see
+  ``impstab._jit``); the CPU ratio of a warm ``critical --json`` on every other example too;
 * the first ``critical`` and the first ``simulate`` with an empty kernel cache (each its own
   empty ``NUMBA_CACHE_DIR``: numba compiles), against the first of each after
   ``python -m impstab.precompile`` filled another empty one (numba loads); the precompile step
   itself is timed too (``--skip-cold`` leaves these out: minutes);
 * where a warm ``critical`` spends its time: ``python -X importtime`` self times summed by
-  top-level package, and, in one process, ``import numba`` and the load of each compiled kernel
-  from the cache.
+  top-level package; in one process, whether numba was imported and the seconds spent in
+  interpreted kernels; and under ``IMPSTAB_JIT=compiled``, ``import numba`` and the load of each
+  compiled kernel from the cache.
 
 Prints tables and ratios and ends with one JSON line.
 """
@@ -56,6 +60,11 @@ def run(argv: list[str], env: dict | None = None) -> tuple[float, float, subproc
     return wall, cpu, res
 
 
+COMPILED = {**os.environ, "IMPSTAB_JIT": "compiled"}
+OTHER_EXAMPLES = ["imp_asymmetric", "imp_damped", "imp_fluid", "imp_viscoelastic", "imp_beam_mounts",
+                  "imp_hardening"]
+
+
 def median_run(argv: list[str], repeat: int, env: dict | None = None) -> tuple[float, float]:
     runs = [run(argv, env)[:2] for _ in range(repeat)]
     return statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs)
@@ -77,6 +86,17 @@ def importtime_breakdown(argv: list[str], repeat: int) -> dict[str, float]:
     names = set().union(*sums)
     return {n: statistics.median(s.get(n, 0.0) for s in sums) for n in names}
 
+
+_INTERPRETED = r"""
+import json, sys, time
+from impstab import _jit
+from impstab.model import load_model
+from impstab.linear.critical_thrust import critical_thrust
+model = load_model(sys.argv[1])
+t = time.process_time(); critical_thrust(model); first = time.process_time() - t
+print(json.dumps({"first_call": first, "interpreted_s": _jit._spent, "numba": "numba" in sys.modules,
+                  "compiled": _jit.compiled()}))
+"""
 
 _KERNEL_LOADS = r"""
 import json, sys, time
@@ -141,15 +161,23 @@ def main() -> int:
         "version": ("impstab --version", [*impstab, "--version"]),
         "help": ("impstab --help", [*impstab, "--help"]),
         "critical": ("impstab critical imp_symmetric.toml --json", critical),
+        "critical_compiled": ("  the same, IMPSTAB_JIT=compiled", critical, COMPILED),
     }
+    for name in OTHER_EXAMPLES:
+        rows[name] = (f"impstab critical {name}.toml --json",
+                      [*impstab, "critical", str(ROOT / "examples" / f"{name}.toml"), "--json"])
     times = {}
-    for key, (label, argv) in rows.items():
-        times[key] = median_run(argv, args.repeat)
+    for key, (label, argv, *env) in rows.items():
+        times[key] = median_run(argv, args.repeat, *env)
         print(f"  {label:46s} {times[key][0]:6.3f} s  (cpu {times[key][1]:6.3f} s)", flush=True)
     base_wall, base_cpu = times["baseline"]
-    ratios = {k: (times[k][0] / base_wall, times[k][1] / base_cpu) for k in ("version", "help", "critical")}
+    ratios = {k: (times[k][0] / base_wall, times[k][1] / base_cpu) for k in ("version", "help", "critical",
+                                                                             "critical_compiled")}
     for k, (rw, rc) in ratios.items():
-        print(f"  ratio {k:9s} / baseline: {rw:5.2f} (cpu {rc:5.2f})")
+        print(f"  ratio {k:17s} / baseline: {rw:5.2f} (cpu {rc:5.2f})")
+    examples = {name: times[name][1] / base_cpu for name in OTHER_EXAMPLES}
+    print("  cpu ratio of a warm critical --json / baseline: "
+          + ", ".join(f"{name} {r:.2f}" for name, r in examples.items()))
 
     print("warm critical: import time by package (python -X importtime, self times summed, median)")
     by = importtime_breakdown(critical[1:] if impstab[0] == sys.executable else critical,
@@ -159,9 +187,13 @@ def main() -> int:
         print(f"  {name:16s} {sec * 1e3:7.1f} ms  {100 * sec / total:5.1f} %")
     print(f"  {'total':16s} {total * 1e3:7.1f} ms")
 
-    _, _, res = run([sys.executable, "-c", _KERNEL_LOADS, str(EXAMPLE)])
+    _, _, res = run([sys.executable, "-c", _INTERPRETED, str(EXAMPLE)])
+    ki = json.loads(res.stdout.strip().splitlines()[-1])
+    print(f"warm critical (cpu): first critical_thrust {ki['first_call']:.3f} s, of it {ki['interpreted_s']:.3f} s "
+          f"in interpreted kernels; numba imported: {ki['numba']}")
+    _, _, res = run([sys.executable, "-c", _KERNEL_LOADS, str(EXAMPLE)], COMPILED)
     kl = json.loads(res.stdout.strip().splitlines()[-1])
-    print(f"numba in a warm critical (cpu): import numba {kl['import_numba']:.3f} s; "
+    print(f"IMPSTAB_JIT=compiled (cpu): import numba {kl['import_numba']:.3f} s; "
           f"first critical_thrust {kl['first_call']:.3f} s, second {kl['second_call'] * 1e3:.2f} ms")
     for name, sec in kl["loads"]:
         print(f"  load from the cache  {name:50s} {sec:6.3f} s")
@@ -170,6 +202,9 @@ def main() -> int:
         "version_s": times["version"][0], "help_s": times["help"][0], "warm_critical_s": times["critical"][0],
         "baseline_s": base_wall, "version_ratio": ratios["version"][0], "help_ratio": ratios["help"][0],
         "warm_critical_ratio": ratios["critical"][0], "warm_critical_cpu_ratio": ratios["critical"][1],
+        "warm_critical_compiled_cpu_ratio": ratios["critical_compiled"][1],
+        "warm_critical_cpu_ratio_examples": examples, "interpreted_kernels_cpu_s": ki["interpreted_s"],
+        "numba_imported": ki["numba"],
         "import_numba_cpu_s": kl["import_numba"], "kernel_loads_cpu_s": kl["first_call"] - kl["second_call"],
         "numba_import_share": by.get("numba", 0.0) / total if total else None,
     }

@@ -58,6 +58,9 @@ from pathlib import Path
 import numpy as np
 
 import impstab
+from impstab._jit import require_compiled
+
+require_compiled()  # the kernels are what is timed here (a lone call in a fresh process runs them interpreted)
 from impstab.linear.engine import second_order_problem
 from impstab.linear.linearize import ModelFamily
 from impstab.model import model_from_dict

@@ -237,6 +237,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     _numba_cache.install()
+    # compile from the first call here and in the worker processes (a single-model command would
+    # otherwise run its kernels interpreted, see impstab._jit, and compile nothing)
+    os.environ["IMPSTAB_JIT"] = "compiled"
     if args.clean:
         return _clean()
     marker = _numba_cache.cache_dir() / MARKER

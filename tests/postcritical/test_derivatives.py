@@ -159,3 +159,38 @@ def test_bad_systems_are_rejected_with_one_line():
     wrong = DynamicalSystem(lambda x, p: x[:, :2], 3, vectorized=True)
     with pytest.raises(ModelError, match="rhs"):
         jacobians(wrong, X0[None], P0)
+
+
+def _contact(x, p):
+    """A smooth law plus a cubic contact force engaging at x0 = 0.5 (a seam: C2, not analytic)."""
+    gap = x[:, 0] - 0.5
+    contact = np.where(gap.real > 0.0, 1e3 * gap ** 3, 0.0 * gap)
+    return np.stack([np.sin(x[:, 0]) * x[:, 1] - contact, x[:, 0] ** 2 * x[:, 1]], axis=-1)
+
+
+def test_circles_stay_inside_the_piece_of_a_piecewise_law():
+    # at x0 = 0.45, 0.05 from the seam, a circle of radius 1 crosses it: the forms it gives are not
+    # the derivatives of the free piece; the region codes shrink it until the disc stays free
+    x = np.array([0.45, 0.8])
+    u, v, w = np.array([1.0, 0.3]), np.array([0.2, -1.0]), np.array([0.7, 0.5])
+    # free piece: f0 = sin(x0) x1, f1 = x0^2 x1; C(u, v, w) by hand
+    x0, x1 = x
+    c0 = -np.cos(x0) * x1 * u[0] * v[0] * w[0] - np.sin(x0) * (u[0] * v[0] * w[1] + u[0] * v[1] * w[0] + u[1] * v[0] * w[0])
+    c1 = 2 * (u[0] * v[0] * w[1] + u[0] * v[1] * w[0] + u[1] * v[0] * w[0])
+    exact = np.array([c0, c1])
+    blind = Forms(DynamicalSystem(_contact, 2, vectorized=True), x, 0.0, radius=1.0, points=32)
+    assert np.max(np.abs(blind.third(u, v, w).value - exact)) > 1.0          # wrong: the circle crossed the seam
+    aware = Forms(DynamicalSystem(_contact, 2, vectorized=True,
+                                  region=lambda s: (np.asarray(s)[:, 0].real > 0.5).astype(int)), x, 0.0,
+                  radius=1.0, points=32)
+    got = aware.third(u, v, w)
+    assert np.max(np.abs(got.value - exact)) <= got.error < 1e-8
+    assert aware.smallest_radius < 0.05 / 1.5                                 # the disc ends before the seam
+
+
+def test_a_point_on_a_seam_is_reported():
+    on_seam = DynamicalSystem(_contact, 2, vectorized=True, region=lambda s: (np.asarray(s)[:, 0].real > 0.5).astype(int))
+    from impstab.errors import NumericalError
+
+    with pytest.raises(NumericalError, match="seam"):
+        Forms(on_seam, np.array([0.5, 0.8]), 0.0).third(np.array([1.0, 0.0]), np.array([1.0, 0.0]), np.array([1.0, 0.0]))

@@ -242,4 +242,4 @@ def test_nearly_symmetric_pair_is_a_hopf_point_with_a_warning():
 
     h = hopf_analysis(DynamicalSystem(f, 4, vectorized=True), np.zeros(4), 0.001)
     assert h.bifurcation == "supercritical" and h.lyapunov_coefficient == pytest.approx(-2.0, rel=1e-10)
-    assert any("another eigenvalue" in w for w in h.warnings)
+    assert any("near neighbour" in w for w in h.warnings)

@@ -67,8 +67,9 @@ def test_a_model_report_has_every_section(iso):
     assert html == rep.html
     assert parse(html).sections == {s.name: s.status for s in rep.sections}
     text = page_text(html)
-    # the isolation example's onset is a collision of two pairs: degenerate, with the reason
-    assert "Post-critical behaviour" in text and "collision on the imaginary axis" in text
+    # the isolation example's onset: a simple pair with a near neighbour (2.6e-2 of |lambda| away),
+    # a plain Hopf point, supercritical (l1 = -3.7e-6; docs/postcritical.md)
+    assert "Post-critical behaviour" in text and "supercritical" in text
 
 
 def test_the_page_is_self_contained(iso):

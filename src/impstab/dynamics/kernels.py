@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 
 from .rhs import AMPLITUDE, DOUBLE, HALVE, KIND_LINEAR, KIND_MODEL, NONFINITE, OK, PITCH, linear_rhs, model_rhs, workspace
 
@@ -65,7 +65,7 @@ def _shift(carry, znew, fnew, pc, n):
         carry[7, i] = pc[i]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", compile_first=True)
 def run_fixed(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist, out_z, out_err, k0,
               weights, tol, amp_limit, allow_double):
     """Advance ``n_steps`` fixed steps of size ``h`` (s) from the state in ``carry[0]``.

@@ -52,7 +52,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 
 from ..kinematics.scalar import cos, sin
 from ..kinematics.so3 import _jinv_into, _log_so3_into
@@ -301,7 +301,7 @@ def linear_rhs(amat, z, out):
     return OK
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", compile_first=True)
 def rhs_into(kind, arrays, yeq, z, thrust, spin, out):
     """``out = z'`` at deviation ``z`` with thrust ``thrust`` (N) and spin ``spin`` (rad/s).
 
@@ -315,7 +315,7 @@ def rhs_into(kind, arrays, yeq, z, thrust, spin, out):
                      yeq, z, thrust, spin, out, rot, jinv, ws)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", compile_first=True)
 def rhs_batch(kind, arrays, yeq, zs, thrust, spin, out, status):
     """``out[k] = z'`` at each row ``zs[k]`` (real or complex), one workspace for all rows;
     ``status[k]`` the row's status."""
@@ -332,7 +332,7 @@ def rhs_batch(kind, arrays, yeq, zs, thrust, spin, out, status):
                                   rot, jinv, ws)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", compile_first=True)
 def mount_loads_series(arrays, yeq, zs, out):
     """Mount forces (hull frame, N) and mount moments (N m) on the body for each state row of
     ``zs``; ``out`` has shape ``(n_samples, n_mounts, 6)``."""

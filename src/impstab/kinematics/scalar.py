@@ -5,7 +5,7 @@
 with comparisons on ``x.real`` only, gets a complex128 specialisation from numba, so that
 complex-step and Cauchy-integral derivatives of it are exact (THEORY 7; used by the nonlinear
 right-hand side and the mount laws). For a real argument the compiled and the plain-Python
-(``NUMBA_DISABLE_JIT=1``) paths call the same C library function, so both give identical bits.
+(:mod:`impstab._jit`'s interpreted) paths call the same C library function, so both give identical bits.
 """
 
 from __future__ import annotations
@@ -13,8 +13,7 @@ from __future__ import annotations
 import cmath
 import math
 
-from numba import types
-from numba.extending import overload
+from .._jit import on_compile
 
 __all__ = ["sqrt", "sin", "cos", "acos"]
 
@@ -39,17 +38,22 @@ def acos(x):
     return cmath.acos(x) if isinstance(x, complex) else math.acos(x)
 
 
-def _pair(real, cplx):
-    def typer(x):
-        if isinstance(x, types.Complex):
-            return lambda x: cplx(x)
-        if isinstance(x, (types.Float, types.Integer)):
-            return lambda x: real(x)
-        return None
-    return typer
+@on_compile
+def _register() -> None:
+    """Give numba the real and complex specialisations (when the process compiles its kernels)."""
+    from numba import types
+    from numba.extending import overload
 
+    def pair(real, cplx):
+        def typer(x):
+            if isinstance(x, types.Complex):
+                return lambda x: cplx(x)
+            if isinstance(x, (types.Float, types.Integer)):
+                return lambda x: real(x)
+            return None
+        return typer
 
-overload(sqrt)(_pair(math.sqrt, cmath.sqrt))
-overload(sin)(_pair(math.sin, cmath.sin))
-overload(cos)(_pair(math.cos, cmath.cos))
-overload(acos)(_pair(math.acos, cmath.acos))
+    overload(sqrt)(pair(math.sqrt, cmath.sqrt))
+    overload(sin)(pair(math.sin, cmath.sin))
+    overload(cos)(pair(math.cos, cmath.cos))
+    overload(acos)(pair(math.acos, cmath.acos))

@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 
 from .scalar import acos, cos, sin, sqrt
 
@@ -63,9 +63,11 @@ def _exp_so3(phi):
 def _log_so3_into(rot, w):
     """Rotation vector of ``rot`` (angle below pi) into ``w[0:3]``."""
     c = 0.5 * (rot[0, 0] + rot[1, 1] + rot[2, 2] - 1.0)
-    if c.real > 1.0:  # rounding beyond the identity: clamp the real part
+    # rounding beyond the identity: clamp a real cosine (a complex one is the analytic
+    # continuation, beyond 1 on half of any complex circle: acos(c)^2 is analytic there)
+    if c.imag == 0.0 and c.real > 1.0:
         c = c - (c.real - 1.0)
-    elif c.real < -1.0:
+    elif c.imag == 0.0 and c.real < -1.0:
         c = c - (c.real + 1.0)
     theta = acos(c)
     if theta.real < 1e-4:

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 from math import copysign, sqrt
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 from numpy.typing import NDArray
 
 from .small_eig import MAX_ORDER, _balance, _solve_one, eigvals_affine

@@ -21,7 +21,7 @@ written in first-order form).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 from numpy.typing import NDArray
 
 __all__ = ["unstable_masks", "classify_eigenvalues"]
@@ -49,6 +49,28 @@ def _masks(vals, undamped, tol_unstable, tol_cluster, floor_rel, cplx, neg):
                 neg[s, i] = grow and real
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _insert(sorted_, i, x):
+    """Insert ``x`` into the ascending ``sorted_[:i]`` (insertion sort: ``n`` is small)."""
+    j = i
+    while j > 0 and sorted_[j - 1] > x:
+        sorted_[j] = sorted_[j - 1]
+        j -= 1
+    sorted_[j] = x
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _least_gap(sorted_, n, tol_duplicate):
+    """The smallest difference of neighbours of the ascending ``sorted_[:n]`` that is at least
+    ``tol_duplicate`` (closer ones are duplicates of one value); ``inf`` if none."""
+    gap = np.inf
+    for i in range(n - 1):
+        d = sorted_[i + 1] - sorted_[i]
+        if d >= tol_duplicate and d < gap:
+            gap = d
+    return gap
+
+
 @njit(cache=True, error_model="numpy")
 def _indicators(vals, undamped, cplx, neg, tol_duplicate, unstable, indicator):
     count, n = vals.shape
@@ -67,18 +89,9 @@ def _indicators(vals, undamped, cplx, neg, tol_duplicate, unstable, indicator):
                 mag = max(abs(vals[s, i]), 1e-300)
                 scale = max(scale, mag)
                 worst = max(worst, abs(vals[s, i].imag) / mag)
-            for i in range(n):  # insertion sort of the scaled real parts (n is small)
-                x = vals[s, i].real / scale
-                j = i
-                while j > 0 and re[j - 1] > x:
-                    re[j] = re[j - 1]
-                    j -= 1
-                re[j] = x
-            gap = np.inf
-            for i in range(n - 1):
-                d = re[i + 1] - re[i]
-                if d >= tol_duplicate and d < gap:
-                    gap = d
+            for i in range(n):  # the scaled real parts, sorted
+                _insert(re, i, vals[s, i].real / scale)
+            gap = _least_gap(re, n, tol_duplicate)
             indicator[s, 0] = -worst if any_c else gap
             indicator[s, 1] = -worst if any_c else re[0]
         else:
@@ -87,18 +100,9 @@ def _indicators(vals, undamped, cplx, neg, tol_duplicate, unstable, indicator):
             for i in range(n):
                 growth = max(growth, vals[s, i].real / max(abs(vals[s, i]), 1e-300))
                 scale = max(scale, abs(vals[s, i]), 1e-300)
-            for i in range(n):  # insertion sort of the scaled frequencies
-                x = abs(vals[s, i].imag) / scale
-                j = i
-                while j > 0 and re[j - 1] > x:
-                    re[j] = re[j - 1]
-                    j -= 1
-                re[j] = x
-            gap = np.inf
-            for i in range(n - 1):
-                d = re[i + 1] - re[i]
-                if d >= tol_duplicate and d < gap:
-                    gap = d
+            for i in range(n):  # the scaled frequencies, sorted
+                _insert(re, i, abs(vals[s, i].imag) / scale)
+            gap = _least_gap(re, n, tol_duplicate)
             indicator[s, 0] = -growth
             indicator[s, 1] = -growth if bad else gap
 

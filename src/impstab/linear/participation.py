@@ -17,7 +17,7 @@ from __future__ import annotations
 from math import sqrt
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 
 from .small_eigvec import _lu, _lu_solve
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 from math import copysign, sqrt
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 from numpy.typing import NDArray
 
 __all__ = ["eigvals_small", "eigvals_affine", "MAX_ORDER"]
@@ -247,7 +247,22 @@ def _francis(a, n, wr, wi):  # noqa: C901 - one algorithm, kept in one piece
     return True
 
 
-@njit(cache=True, error_model="numpy")
+def _solve_one_lapack(a, n, v, wr, wi, out_row):
+    """:func:`_solve_one` while kernels run interpreted: LAPACK ``geev`` through NumPy.
+
+    The same contract (eigenvalues of ``a[:n, :n]`` into ``out_row``, complex pairs adjacent with
+    the positive imaginary part first and exactly conjugate, real ones with a zero imaginary part;
+    False when not finite) and the same backward-stable algorithm, which in plain Python is far
+    faster than interpreting the QR iteration below.
+    """
+    m = a[:n, :n]
+    if not np.isfinite(m).all():
+        return False
+    out_row[:n] = np.linalg.eigvals(m)
+    return True
+
+
+@njit(cache=True, error_model="numpy", interpreted=_solve_one_lapack)
 def _solve_one(a, n, v, wr, wi, out_row):
     """Eigenvalues of the matrix in ``a`` (destroyed) into ``out_row``.
 

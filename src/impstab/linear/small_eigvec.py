@@ -22,7 +22,7 @@ from __future__ import annotations
 from math import sqrt
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 
 from .small_eig import _solve_one
 

@@ -23,7 +23,7 @@ code runs as plain Python/NumPy and gives identical results.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 
 from ..kinematics.so3 import _cross, _d_jinvT_w, _exp_so3, _jinv, _log_so3, _skew
 from ..model.mount_law import LAW_K3_AXIAL, N_LAW, law_gradient, law_hessian

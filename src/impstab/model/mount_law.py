@@ -32,7 +32,7 @@ law) is real-only.
 
 from __future__ import annotations
 
-from numba import njit
+from .._jit import njit
 
 from ..kinematics.scalar import sqrt
 

@@ -65,16 +65,10 @@ class Condensation:
                                      np.full(size, size - 2), np.full(size, size - 1)])
         self._cols = np.concatenate([cols_a.reshape(-1), cols_b.reshape(-1), cols_h, np.arange(size), np.arange(size)])
 
-    def solve(self, rhs: Array, border: Array, border_rhs: Array) -> Array:
-        """Solve ``J x = (rhs, border_rhs)`` with the border rows ``border`` ``(2, N m n + 2)``.
-
-        ``rhs`` is the collocation part ``(N m n,)``; returns ``x`` in the node layout of
-        :class:`~impstab.postcritical.periodic.OrbitProblem` (nodes, then ``T``, ``p``).
-        """
+    def factor(self, border: Array):
+        """The sparse LU factorization of the condensed system with the border rows ``border``."""
         n_int, m, n, k = self.N, self.m, self.n, self.k
         nx = n_int * m * n
-        rq = (self.qt @ rhs.reshape(n_int, m * n, 1))[:, :, 0]
-        t = np.linalg.solve(self.r_top, rq[:, :k, None])[:, :, 0]                   # (N, k)
         c_nodes = border[:, :nx].reshape(2, n_int, m, n)
         c_v = c_nodes[:, :, 0, :]                                                    # (2, N, n)
         c_w = c_nodes[:, :, 1:, :].reshape(2, n_int, k)
@@ -82,12 +76,27 @@ class Condensation:
         coef_v = c_v - cs[:, :, :n]
         coef_v = coef_v + np.roll(-cs[:, :, n: 2 * n], 1, axis=1)                    # v_(i+1) of interval i
         coef_mu = border[:, nx:] - cs[:, :, 2 * n:].sum(axis=1)
-        r_border = border_rhs - np.einsum("rik,ik->r", c_w, t)
         data = np.concatenate([self.a.reshape(-1), self.b.reshape(-1), self.hb.reshape(-1),
                                np.concatenate([coef_v[0].reshape(-1), coef_mu[0]]),
                                np.concatenate([coef_v[1].reshape(-1), coef_mu[1]])])
         mat = sp.csc_matrix((data, (self._rows, self._cols)), shape=(self.size, self.size))
-        red = spla.splu(mat).solve(np.concatenate([rq[:, k:].reshape(-1), r_border]))
+        return spla.splu(mat)
+
+    def solve(self, rhs: Array, border: Array, border_rhs: Array, lu=None) -> Array:
+        """Solve ``J x = (rhs, border_rhs)`` with the border rows ``border`` ``(2, N m n + 2)``.
+
+        ``rhs`` is the collocation part ``(N m n,)``; returns ``x`` in the node layout of
+        :class:`~impstab.postcritical.periodic.OrbitProblem` (nodes, then ``T``, ``p``). ``lu``:
+        :meth:`factor` of the same ``border``, to reuse (default: factorized here).
+        """
+        n_int, m, n, k = self.N, self.m, self.n, self.k
+        nx = n_int * m * n
+        rq = (self.qt @ rhs.reshape(n_int, m * n, 1))[:, :, 0]
+        t = np.linalg.solve(self.r_top, rq[:, :k, None])[:, :, 0]                   # (N, k)
+        c_w = border[:, :nx].reshape(2, n_int, m, n)[:, :, 1:, :].reshape(2, n_int, k)
+        r_border = border_rhs - np.einsum("rik,ik->r", c_w, t)
+        lu = self.factor(border) if lu is None else lu
+        red = lu.solve(np.concatenate([rq[:, k:].reshape(-1), r_border]))
         v = red[:-2].reshape(n_int, n)
         mu = red[-2:]
         w = (t - np.einsum("ikc,ic->ik", self.s[:, :, :n], v)

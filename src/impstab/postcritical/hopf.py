@@ -53,19 +53,30 @@ CArray = NDArray[np.complex128]
 REAL_TOLERANCE = 1e-8
 #: singular values of (J - lambda B) below this share of the largest: a null direction
 NULL_TOLERANCE = 1e-7
-#: a defective pair (collision): eigenvalue condition above this, or a near neighbour with
-#: kappa * distance above COLLISION_PRODUCT (a near-Jordan block has kappa ~ 1 / distance)
+#: a defective pair (collision, a Jordan block at i omega): eigenvalue condition number above
+#: KAPPA_DEFECTIVE, or another eigenvalue closer than COALESCENCE_DISTANCE (share of the spectral
+#: radius). A double eigenvalue perturbed by a relative error e splits by ~sqrt(e) and has
+#: kappa ~ 1 / sqrt(e): with the complex-step Jacobian exact to e ~ 1e-12 (measured 1e-10 at
+#: worst against finite differences), a computed separation below 1e-6 cannot be told from a
+#: coalescence, and one above it is a simple pair. Simple pairs are plain Hopf points however
+#: close their neighbour: only the range of validity of the normal form shrinks (a warning).
 KAPPA_DEFECTIVE = 1e8
-COLLISION_DISTANCE = 1e-2
-COLLISION_PRODUCT = 0.05
+COALESCENCE_DISTANCE = 1e-6
 #: spectrum symmetric under lambda -> -conj(lambda) to this share of the spectral radius
 SYMMETRY_TOLERANCE = 1e-8
 #: crossing speed below this share of |d lambda / dp|: no transversal crossing
 TRANSVERSALITY_TOLERANCE = 1e-9
-#: a plain Hopf point with another eigenvalue this close (share of the spectral radius): a warning
-NEAR_RESONANCE = 1e-3
-#: |l1| at most this many times its error bound: l1 = 0 to its accuracy
-L1_ZERO_FACTOR = 10.0
+#: a plain Hopf point with another eigenvalue this close (share of |lambda|): a warning that the
+#: normal form holds only for |p - p_c| well below (distance) / |d lambda / dp|
+NEAR_RESONANCE = 0.05
+#: |l1| at most this many times its error bound (a bound, not an estimate: measured errors are 1e2-1e6
+#: times smaller, docs/postcritical.md): l1 = 0 to its accuracy, the sign undecided
+L1_ZERO_FACTOR = 1.0
+#: relative accuracy of l1 aimed at: while the bound is larger, the circles are tried at these
+#: multiples of the given radius in turn (a larger one: less rounding; smaller ones: a singularity
+#: or seam nearer than the radius), and the smallest bound is kept
+L1_TARGET = 1e-6
+RADIUS_LADDER = (1.0, 4.0, 0.25, 1.0 / 16.0)
 #: Newton refinement of the onset: |Re lambda| below this share of |lambda|
 ONSET_TOLERANCE = 1e-13
 ONSET_ITERATIONS = 40
@@ -280,6 +291,8 @@ def hopf_analysis(
         convergence); ``False`` analyses at ``p0`` as given.
     radius, points : float, int
         Cauchy circle of the second and third derivatives (radius in units of the state scale).
+        While the bound of ``l1`` exceeds ``L1_TARGET |l1|``, circles of ``RADIUS_LADDER`` times
+        ``radius`` are tried too, and the smallest bound is kept (``derivative_check["circle_radius"]``).
     check : bool
         Compare the complex-step Jacobian with central differences and the forms between two
         circles (:func:`impstab.postcritical.derivatives.check_derivatives`); a Jacobian
@@ -411,7 +424,7 @@ def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> H
     warnings: list[str] = []
     checks: dict = {}
     if check:
-        checks = check_derivatives(system, x, p)
+        checks = check_derivatives(system, x, p, radius=radius, points=points)
         if checks["jacobian"] > 1e-6:
             warnings.append(f"complex-step and finite-difference Jacobians differ by {checks['jacobian']:.2e} "
                             "(relative): is f analytic in its complex extension?")
@@ -446,22 +459,34 @@ def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> H
                          frequency_slope=float(dlam.imag) if transversal else None,
                          bifurcation="degenerate", reason=reason, h20=None, h11=None,
                          equilibrium_slope=x_p if transversal else None, warnings=tuple(warnings), **base)
-    others = np.delete(spec.eigenvalues, idx)
-    if others.size and np.min(np.abs(others - lam)) <= NEAR_RESONANCE * scale:
-        warnings.append(f"another eigenvalue lies within {np.min(np.abs(others - lam)) / scale:.1e} (relative) of the "
-                        "critical one: the single-pair normal form holds only very close to the onset")
+    near = _near_eigenvalue_warning(spec, idx, lam, kappa, dlam, system)
+    if near:
+        warnings.append(near)
     if lam.imag < 0:
         q, w, lam = np.conj(q), np.conj(w), np.conj(lam)
     om = lam.imag
     w_t = w / np.conj(np.vdot(w, mass @ q))          # w_t^H B q = 1
     adjoint = mass.T @ w_t                             # p = B^H w_t, p^H q = 1
-    c1, h20, h11, err = _first_coefficient(forms, jac, mass, q, w_t, om)
+    # the circle's radius: the given one, then smaller ones while the bound stays above
+    # L1_TARGET |l1| (a singularity or a seam closer than the radius shows as a large tail or
+    # a disagreement with the half circle); the smallest bound wins
+    best = None
+    ladder = [radius * f for f in RADIUS_LADDER] if forms.method != "analytic" else [radius]
+    for r in ladder:
+        c1, h20, h11, err = _first_coefficient(Forms(system, x, p, radius=r, points=points), jac, mass, q, w_t, om)
+        l1_err = err / om
+        if forms.method != "analytic":
+            c1b = _first_coefficient(Forms(system, x, p, radius=r / 2, points=2 * points), jac, mass, q, w_t, om)[0]
+            l1_err = max(l1_err, abs(c1b.real - c1.real) / om)
+        if best is None or l1_err < best[3]:
+            best = (c1, h20, h11, l1_err, r)
+        if l1_err <= L1_TARGET * abs(c1.real / om):
+            break
+    c1, h20, h11, l1_err, r = best
     l1 = c1.real / om
-    l1_err = err / om
     if forms.method != "analytic":
-        f2 = Forms(system, x, p, radius=radius / 2, points=2 * points)
-        c1b = _first_coefficient(f2, jac, mass, q, w_t, om)[0]
-        l1_err = max(l1_err, abs(c1b.real - c1.real) / om)
+        checks = dict(checks, circle_radius=float(r))
+        base["derivative_check"] = checks
     kw = dict(eigenvector=q, adjoint=adjoint, crossing_speed=float(dlam.real), frequency_slope=float(dlam.imag),
               h20=h20, h11=h11, equilibrium_slope=x_p, warnings=tuple(warnings))
     if abs(l1) <= L1_ZERO_FACTOR * l1_err:
@@ -498,6 +523,25 @@ def _first_coefficient(forms: Forms, jac, mass, q, w_t, om) -> tuple[complex, CA
     return complex(g / 2), h20, h11, float(err)
 
 
+def _near_eigenvalue_warning(spec: Spectrum, idx, lam, kappa, dlam, system: DynamicalSystem) -> str | None:
+    """A warning when another eigenvalue lies within NEAR_RESONANCE |lambda| of the simple critical one."""
+    others = np.delete(spec.eigenvalues, idx)
+    if not others.size:
+        return None
+    k = int(np.argmin(np.abs(others - lam)))
+    gap = float(abs(others[k] - lam))
+    if gap > NEAR_RESONANCE * abs(lam):
+        return None
+    span = gap / abs(dlam) if math.isfinite(abs(dlam)) and abs(dlam) > 0 else math.nan
+    name = system.parameter_name
+    unit = f" {system.parameter_units}" if system.parameter_units else ""
+    return (f"near neighbour: eigenvalue {complex(others[k]):.6g} lies {gap:.3g} 1/{system.time_units} from the "
+            f"critical one ({gap / abs(lam):.2e} of |lambda|, eigenvalue condition number {kappa:.3g}). The pair is "
+            f"simple, so the Hopf theory and its label hold, but the single-pair normal form describes the cycles "
+            f"only for |{name} - {name}_c| well below gap / |d lambda/d {name}| = {span:.3g}{unit}; farther out only "
+            "the computed branch is reliable")
+
+
 def _degeneracy(jac, mass, spec: Spectrum, idx, lam, kappa, dlam, scale) -> tuple[str | None, int]:
     """Why a pair at ``lam`` is not a plain Hopf point (None when it is), and the multiplicity."""
     lam_all = spec.eigenvalues
@@ -508,7 +552,9 @@ def _degeneracy(jac, mass, spec: Spectrum, idx, lam, kappa, dlam, scale) -> tupl
     dist = float(np.min(np.abs(others - lam)) / scale) if others.size else math.inf
     mirror = np.array([np.min(np.abs(lam_all + np.conj(v))) for v in lam_all])
     symmetric_spectrum = bool(np.all(mirror <= SYMMETRY_TOLERANCE * scale))
-    defective = kappa >= KAPPA_DEFECTIVE or (dist <= COLLISION_DISTANCE and kappa * dist >= COLLISION_PRODUCT)
+    # a neighbour closer than the resolution with one eigenvector: a Jordan block (collision);
+    # with two independent eigenvectors: a semisimple double pair unless their Gram matrix is singular
+    defective = kappa >= KAPPA_DEFECTIVE or (null < 2 and dist <= COALESCENCE_DISTANCE)
     if null >= 2:
         right = vh[-null:].conj().T
         left = u[:, -null:]

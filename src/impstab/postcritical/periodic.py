@@ -30,6 +30,10 @@ Array = NDArray[np.float64]
 #: Newton converged when the scaled step is below this (relative)
 NEWTON_TOLERANCE = 1e-10
 NEWTON_ITERATIONS = 12
+#: a chord correction (reusing the last factorized Jacobian) is kept while successive steps shrink
+#: by this factor or more; otherwise the next correction takes a fresh Jacobian. The converged
+#: cycle always gets a fresh Jacobian (its Floquet multipliers and tangent).
+CHORD_RATE = 0.1
 #: converged as well when the residual stagnates below STAGNANT_RESIDUAL of its terms and the
 #: scaled step is below STAGNATION
 STAGNANT_RESIDUAL = 1e-9
@@ -171,9 +175,15 @@ class OrbitProblem:
                                                                                  self.weights.parameter]])
         converged = False
         prev_res = np.inf
+        border = np.stack([phase_full, last])
+        cond, lu = None, None
+        chord = False          # the next correction reuses the last factorization
+        prev_small = np.inf
+        newton = 0             # corrections with a fresh Jacobian
         for it in range(max_iter + 1):
+            fresh = converged or not chord or cond is None
             try:
-                res, blocks, col_t, col_p = self.evaluate(u)
+                res, blocks, col_t, col_p = self.evaluate(u, need_jacobian=fresh)
             except (FloatingPointError, OverflowError, ValueError):
                 return None
             res_norm = float(np.max(np.abs(res)))
@@ -182,23 +192,32 @@ class OrbitProblem:
             full = np.concatenate([res, [g_phase, g_last]])
             if not np.all(np.isfinite(full)):
                 return None
-            cond = Condensation(blocks, col_t, col_p)
+            if fresh:
+                cond, lu = Condensation(blocks, col_t, col_p), None
+                jac_blocks = blocks
             if converged:
-                return Solution(self.profile(u), float(u[-2]), float(u[-1]), u, blocks, cond, phase, it,
+                return Solution(self.profile(u), float(u[-2]), float(u[-1]), u, jac_blocks, cond, phase, newton,
                                 float(np.max(np.abs(res))))
             if it == max_iter:
                 return None
             try:
-                step = cond.solve(-res, np.stack([phase_full, last]), -np.array([g_phase, g_last]))
+                if lu is None:
+                    lu = cond.factor(border)
+                step = cond.solve(-res, border, -np.array([g_phase, g_last]), lu=lu)
             except (RuntimeError, np.linalg.LinAlgError):
                 return None
             if not np.all(np.isfinite(step)):
                 return None
+            newton += int(fresh)
             u = u + step
             if u[-2] <= 0:
                 return None
             size = max(1.0, float(np.max(np.abs(u / scale))))
             small = float(np.max(np.abs(step / scale)))
+            # chord steps (the Jacobian of an earlier iterate) while they contract by CHORD_RATE or
+            # better: then the error left after a step is below CHORD_RATE / (1 - CHORD_RATE) of it
+            chord = fresh or small <= CHORD_RATE * prev_small
+            prev_small = small
             if small <= tol * size:
                 converged = True
             elif it >= 2 and small <= STAGNATION * size and res_norm <= STAGNANT_RESIDUAL * self.residual_scale \

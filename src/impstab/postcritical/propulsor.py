@@ -53,6 +53,9 @@ DEFAULTS = {
     "ds_max": 0.5,
     "intervals": 40,
     "degree": 4,
+    # Cauchy circles of the second and third derivatives, in state scales (see propulsor_system)
+    "circle_radius": 10.0,
+    "circle_points": 32,
 }
 #: phases per period at which mount deflections and forces are sampled
 MOUNT_SAMPLES = 128
@@ -75,8 +78,43 @@ def propulsor_system(model, omega: float | None = None) -> tuple[DynamicalSystem
 
     system = DynamicalSystem(rhs, 12, vectorized=True, complex_parameter=False, state_names=STATE_NAMES,
                              state_units=STATE_UNITS, parameter_name="thrust", parameter_units="N",
-                             time_units="s", state_scale=scale)
+                             time_units="s", state_scale=scale, region=_regions(ns))
     return system, ns
+
+
+def _regions(ns) -> Callable[[NDArray], NDArray]:
+    """The pieces of the right-hand side a (complex) state lies in: the pitch guard
+    (``|Re theta|`` at the limit) and, for each mount with a snubber, free / smoothing ramp /
+    beyond the ramp, by the same real-part tests as the compiled law (:mod:`impstab.model.mount_law`)."""
+    from ..model.mount_law import LAW_CLEARANCE, SNUBBER_SMOOTHING
+
+    pos = np.asarray(ns.system.arrays[0])
+    laws = np.asarray(ns.system.arrays[4])
+    clearance = laws[:, LAW_CLEARANCE] if laws.size else np.zeros(pos.shape[0])
+    snub = np.flatnonzero(clearance > 0.0)
+    arms, clear = pos[snub], clearance[snub]
+    pitch = float(ns.pitch_limit)
+
+    def region(states):
+        y = np.atleast_2d(np.asarray(states, dtype=complex))
+        codes = [(np.abs(y[:, 4].real) >= pitch).astype(np.int64)[:, None]]
+        if snub.size:
+            rot = _rotations(y[:, 3], y[:, 4], y[:, 5])                           # (N, 3, 3)
+            d = y[:, None, :3] + np.einsum("kab,ib->kia", rot, arms) - arms[None]
+            r2 = np.sum(d * d, axis=-1)                                          # analytic, no conjugate
+            contact = r2.real > clear ** 2
+            t = (np.sqrt(r2) - clear) / (SNUBBER_SMOOTHING * clear)
+            codes.append(contact.astype(np.int64) + (contact & (t.real >= 1.0)))
+        return np.concatenate(codes, axis=1)
+
+    return region
+
+
+def _rotations(phi, theta, psi) -> NDArray:
+    """z-y-x Euler rotation matrices (body -> hull) of a batch of (complex) angles, (N, 3, 3)."""
+    from ..kinematics import euler_zyx_to_matrix
+
+    return np.moveaxis(np.asarray(euler_zyx_to_matrix(phi, theta, psi)), -1, 0)
 
 
 def mount_peaks(ns, states: NDArray) -> tuple[float, float, bool]:
@@ -87,13 +125,12 @@ def mount_peaks(ns, states: NDArray) -> tuple[float, float, bool]:
     contact: ``|d|`` beyond a mount's snubber clearance somewhere on the samples.
     """
     from ..dynamics.system import mount_loads
-    from ..kinematics import euler_zyx_to_matrix
     from ..model.mount_law import LAW_CLEARANCE
 
     states = np.atleast_2d(np.asarray(states, dtype=float))
     pos = np.asarray(ns.system.arrays[0])
     laws = np.asarray(ns.system.arrays[4])
-    rot = np.array([euler_zyx_to_matrix(*s[3:6]) for s in states])              # (k, 3, 3)
+    rot = _rotations(states[:, 3], states[:, 4], states[:, 5])                  # (k, 3, 3)
     d = states[:, None, :3] + np.einsum("kab,ib->kia", rot, pos) - pos[None, :, :]
     dn = np.linalg.norm(d, axis=-1)                                              # (k, mounts)
     loads = mount_loads(ns.system, np.zeros(12), states)
@@ -192,7 +229,8 @@ def propulsor_postcritical(
             requested=requested, stable_below=crit.thrust, **base)
     system, ns = propulsor_system(model, crit.omega)
     x0 = ns.equilibrium(crit.thrust)
-    hopf = hopf_analysis(system, x0, crit.thrust, omega=crit.omega if crit.kind == "flutter" else None)
+    hopf = hopf_analysis(system, x0, crit.thrust, omega=crit.omega if crit.kind == "flutter" else None,
+                         radius=DEFAULTS["circle_radius"], points=DEFAULTS["circle_points"])
     settings["state_scale"] = np.asarray(system.state_scale).tolist()
     kind = "divergence" if hopf.onset == "divergence" else "flutter"
     if hopf.bifurcation == "degenerate" and not (hopf.reason or "").startswith("l1 = 0"):

@@ -226,7 +226,7 @@ class PostcriticalResult:
                         f"{self.fold_thrust:.6g} N, with hysteresis; practical limit thrust {self.fold_thrust:.6g} N "
                         f"(the fold)")
             return (f"dangerous: the onset at T_c = {tc:.6g} N is subcritical and the computed branch shows no fold "
-                    f"(it reached {self.stop_reason}); large oscillations exist at least down to "
+                    f"(it stopped: {self.stop_reason}); large oscillations exist at least down to "
                     f"{self.practical_limit_thrust:.6g} N: practical limit thrust below that")
         return (f"undetermined: the plain Hopf theory does not apply at T_c = {tc:.6g} N ({self.reason}); "
                 f"practical limit thrust T_c = {tc:.6g} N")

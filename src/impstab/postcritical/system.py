@@ -22,6 +22,14 @@ same batch convention (shown here for ``vectorized=True``; drop the leading ``N`
 ``jacobian(X, p) -> (N, n, n)``, ``second_derivative(X, p, U, V) -> (N, n)`` (the bilinear form
 ``B(u, v) = sum_jk d2f/dx_j dx_k u_j v_k``) and ``third_derivative(X, p, U, V, W) -> (N, n)``;
 ``U``, ``V``, ``W`` may be complex.
+
+Piecewise right-hand sides (a contact law, a guard) are analytic only inside each piece. The
+optional ``region(X) -> (N,) or (N, k)`` integer codes say which piece each (complex) state of a
+batch lies in, decided on real parts of analytic functions of the state (``Re(d . d) > c^2``).
+The Cauchy circles of the second and third derivatives are shrunk until every point of a circle
+(sampled four times finer than the circle itself, at 1.5 times its radius) has the centre's
+codes: a real part of an analytic function is harmonic, so it takes its extremes on the boundary
+of the disc, and the whole disc then lies in the centre's piece, where ``f`` is analytic.
 """
 
 from __future__ import annotations
@@ -67,6 +75,9 @@ class DynamicalSystem:
     state_scale : (n,) array, optional
         Typical size of each state (its unit of "small"); it weighs the arclength and the
         derivative circles. Default ones.
+    region : callable, optional
+        ``region(X)``: integer codes of the piece of a piecewise ``f`` each state of the batch
+        ``X`` (complex, ``(N, n)``) lies in (see the module notes); None: ``f`` is analytic.
     """
 
     rhs: Callable[..., Any]
@@ -83,6 +94,7 @@ class DynamicalSystem:
     parameter_units: str = ""
     time_units: str = "s"
     state_scale: Array | None = None
+    region: Callable[..., Any] | None = None
 
     def __post_init__(self) -> None:
         n = self.dimension

@@ -24,7 +24,7 @@ by the pivot ratio, instead of raising); with ``NUMBA_DISABLE_JIT=1`` the same c
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .._jit import njit
 
 __all__ = ["solve_harmonic", "response_outputs", "eliminate"]
 
@@ -81,7 +81,7 @@ def eliminate(a, b):  # pragma: no cover - compiled
     return small / big if big > 0.0 else 0.0
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", compile_first=True)
 def solve_harmonic(mass, damping, stiffness, omega, loads, extra, maps, mount_k, mount_c, hull):  # pragma: no cover - compiled
     """Solve ``Z q = F`` for every design and frequency.
 
@@ -195,7 +195,7 @@ def _quad_parts(a, qr, qi):  # pragma: no cover - compiled
     return re, im
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", compile_first=True)
 def response_outputs(
     q, omega, loads, extra, maps, force_k, force_c, damper, mount_k, mount_c, hull, load_k, fluid_d
 ):  # pragma: no cover - compiled

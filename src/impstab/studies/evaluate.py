@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from .._jit import require_compiled
 from ..errors import ModelError
 from ..linear.batch import STATUSES, AffineDesign, critical_thrust_batch
 from ..model.assemble import model_from_dict
@@ -91,6 +92,7 @@ def evaluate_chunk(task: ChunkTask) -> ChunkResult:
     ChunkResult
         Arrays of shape ``task.block``; ``status`` codes index :data:`impstab.linear.batch.STATUSES`.
     """
+    require_compiled()  # a chunk is many designs: the compiled kernels from its first one
     enabled = gc.isenabled()
     gc.disable()
     try:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from numba import njit
+from ..._jit import njit
 
 from ..eigen import state_matrices
 from ..small_eigvec import _lu, _lu_solve

@@ -32,7 +32,7 @@ from __future__ import annotations
 from math import sqrt
 
 import numpy as np
-from numba import njit
+from ..._jit import njit
 
 from ..classify import _masks
 from ..participation import participation_into

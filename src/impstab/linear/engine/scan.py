@@ -22,7 +22,7 @@ the end of the range and also closes each bubble from its far side (a regain of 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, objmode
+from ..._jit import njit, objmode
 
 from ..classify import _indicators, _masks
 from ..small_eigvec import _eigvector

@@ -18,6 +18,7 @@ from . import large
 from .problems import Problem
 from .spectra import register, unregister
 from .tolerances import TOL_UNSTABLE
+from ..._jit import require_compiled
 
 __all__ = ["Outcome", "Crossing", "StackOutcome", "solve", "solve_affine", "PROVIDER_CHUNK"]
 
@@ -134,6 +135,8 @@ def _jobs(problems: list[Problem], chunk: int) -> tuple[Jobs, list[int]]:
 def _run(jobs: Jobs, n_dof: int, all_crossings: bool):
     """The two compiled loops over a stack: ``(onsets, counts, mode, part)`` (see ``layout``)."""
     count = len(jobs.ints)
+    if count > 2:
+        require_compiled()  # a stack of designs: compiled from its first problem
     onsets = np.full((count, 2 * jobs.grids.shape[1], 7), np.nan)
     counts = np.zeros((count, 8), dtype=np.int64)
     mode = np.zeros((count, n_dof), dtype=np.complex128)

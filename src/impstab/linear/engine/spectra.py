@@ -29,7 +29,7 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
-from numba import njit, objmode
+from ..._jit import njit, objmode
 
 from ..blocks import block_eig_at, block_eigvals_at, eig_workspace
 from ..small_eig import MAX_ORDER, _solve_one
