@@ -59,6 +59,7 @@ sys.path.insert(0, str(ROOT / "src"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import impstab  # noqa: E402
+from impstab._jit import require_compiled  # noqa: E402
 from impstab.dynamics.simulate import default_step  # noqa: E402
 from impstab.postcritical import propulsor_postcritical  # noqa: E402
 
@@ -88,6 +89,7 @@ def rel_err(amp, ref):
 
 
 def main() -> None:
+    require_compiled()  # the kernels are what is timed here (a fresh process starts them interpreted)
     model = impstab.load_model(ROOT / "examples" / "imp_hardening.toml")
     crit = impstab.critical_thrust(model)
     tc = crit.thrust

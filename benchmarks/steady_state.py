@@ -152,9 +152,11 @@ def settle_sweep(model, thrusts, *, tolerance: float, period: float, step: float
     max_cycles : int
         Cycles at most per thrust; beyond it the thrust is listed in ``unsettled``.
     """
+    from impstab._jit import require_compiled
     from impstab.dynamics.integrators import Problem, get_integrator
     from impstab.dynamics.system import equilibrium_state, pack_dynamics
 
+    require_compiled()  # a long time integration: the compiled kernels from the start
     system = pack_dynamics(model)
     length = system.length_scale
     hamming = get_integrator("hamming")
