@@ -122,7 +122,30 @@ def _eigvector(w0, m, lam, norm, b, piv, x):
     return False
 
 
-@njit(cache=True, error_model="numpy")
+def _eig_block_lapack(w, w0, m, v, wr, wi, vals, vecs, inv, b, piv, x, b_real, x_real):
+    """:func:`_eig_block` while kernels run interpreted: LAPACK ``geev`` and an LU inverse through NumPy.
+
+    The same contract (unit eigenvectors, a real eigenvalue's vector real, a complex pair's
+    exactly conjugate, False when a step fails) and LAPACK's vectors, which the engine already
+    takes wherever the compiled inverse iteration gives up.
+    """
+    a = w0[:m, :m]
+    if not np.isfinite(a).all():
+        return False
+    values, vectors = np.linalg.eig(a)
+    try:
+        inverse = np.linalg.inv(vectors)
+    except np.linalg.LinAlgError:
+        return False
+    if not np.isfinite(inverse).all():
+        return False
+    vals[:m] = values
+    vecs[:m, :m] = vectors
+    inv[:m, :m] = inverse
+    return True
+
+
+@njit(cache=True, error_model="numpy", interpreted=_eig_block_lapack)
 def _eig_block(w, w0, m, v, wr, wi, vals, vecs, inv, b, piv, x, b_real, x_real):
     """Eigenvalues (compiled QR), unit eigenvectors and their inverse of the block ``w0[:m, :m]``.
 
