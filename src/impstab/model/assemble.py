@@ -23,9 +23,7 @@ from .isolation_specs import excitation_from_spec, foundation_from_spec
 from .fluid import FluidLoading, Hull
 from .model import AnalysisSettings, Model
 from .mounts import Mount, NonlinearLaw, axial_shear_matrix, elastic_stiffness, ring_positions
-from .reference import DOC_PATH
 from .schema import UNION_TAGS, ModelFile, mark_at
-from .schema_doc import clean_loc, unknown_key_rule
 from .thrust import Propeller, Thrust
 
 __all__ = ["load_model", "model_from_dict", "format_location", "unit_vector", "read_toml", "read_text", "check_nesting"]
@@ -77,6 +75,8 @@ _TYPE_RULES = {
 def _error_loc(root, error: dict) -> tuple:
     """Where a pydantic error is, without union labels; an unknown key is kept as written (it may
     hold brackets or any other character that a label has)."""
+    from .schema_doc import clean_loc  # error paths only: the reference machinery is not loaded otherwise
+
     loc = tuple(error["loc"])
     if error["type"] == "extra_forbidden" and loc:
         return _plain_loc(clean_loc(root, loc[:-1])) + loc[-1:]
@@ -88,6 +88,9 @@ _VECTOR_SIZES = (3, 6)
 
 
 def _from_validation_error(err: ValidationError, data: Any) -> ModelError:
+    from .reference import DOC_PATH
+    from .schema_doc import unknown_key_rule
+
     errors = err.errors()
     # an unknown key is a typo: report it first (pydantic lists the key it hides as missing first)
     first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
