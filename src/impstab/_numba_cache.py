@@ -41,7 +41,8 @@ SET_BY_IMPSTAB = "IMPSTAB_NUMBA_CACHE_DIR"
 PACKAGE = Path(__file__).resolve().parent
 
 _FROM = re.compile(rb"^[ \t]*from[ \t]+(\.+)([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^#\n]*)", re.M)
-_USES_NUMBA = re.compile(rb"^[ \t]*(?:from|import)[ \t]+numba\b", re.M)
+#: imports numba, or impstab's deferred numba decorator (impstab._jit: kernels compiled on demand)
+_USES_NUMBA = re.compile(rb"^[ \t]*(?:(?:from|import)[ \t]+numba\b|from[ \t]+(?:\.+|impstab\.)_jit[ \t]+import\b)", re.M)
 #: a compiled function defined here: a numba decorator, or one called on a function
 _DEFINES_KERNEL = re.compile(
     rb"(?:^[ \t]*@[ \t]*(?:numba\.|nb\.)?|\b)(?:njit|jit|vectorize|guvectorize|cfunc|stencil|overload|intrinsic)\b[ \t]*[(\n]",
@@ -100,7 +101,7 @@ def kernel_sources(package: Path = PACKAGE) -> dict[Path, bytes]:
     """Contents of the source files that can reach compiled code: every module of ``package``
     that defines numba kernels, and every module of ``package`` they import (transitively)."""
     texts = {p: p.read_bytes() for p in package.rglob("*.py") if "__pycache__" not in p.parts}
-    todo = [p for p, text in texts.items() if b"numba" in text and is_kernel_module(text)]
+    todo = [p for p, text in texts.items() if (b"numba" in text or b"_jit" in text) and is_kernel_module(text)]
     seen: set[Path] = set(todo)
     while todo:
         path = todo.pop()
