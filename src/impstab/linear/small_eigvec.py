@@ -132,17 +132,23 @@ def _eig_block_lapack(w, w0, m, v, wr, wi, vals, vecs, inv, b, piv, x, b_real, x
     a = w0[:m, :m]
     if not np.isfinite(a).all():
         return False
-    values, vectors = np.linalg.eig(a)
+    return lapack_eig(a, vals[:m], vecs[:m, :m], inv[:m, :m]) == 1
+
+
+def lapack_eig(op, vals, vecs, inv):
+    """LAPACK's eigen-decomposition and the inverse of the eigenvectors; 0 where that is singular.
+
+    Results go to ``vals``, ``vecs``, ``inv`` (views are fine); 1 on success. The engine calls it
+    from compiled code (object mode) wherever the compiled inverse iteration gives up.
+    """
+    v, w = np.linalg.eig(op)
+    vals[...] = v
+    vecs[...] = w
     try:
-        inverse = np.linalg.inv(vectors)
+        inv[...] = np.linalg.inv(w)
     except np.linalg.LinAlgError:
-        return False
-    if not np.isfinite(inverse).all():
-        return False
-    vals[:m] = values
-    vecs[:m, :m] = vectors
-    inv[:m, :m] = inverse
-    return True
+        return 0
+    return 1 if np.isfinite(inv).all() else 0
 
 
 @njit(cache=True, error_model="numpy", interpreted=_eig_block_lapack)

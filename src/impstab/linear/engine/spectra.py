@@ -33,6 +33,7 @@ from ..._jit import njit, objmode
 
 from ..blocks import block_eig_at, block_eigvals_at, eig_workspace
 from ..small_eig import MAX_ORDER, _solve_one
+from ..small_eigvec import lapack_eig
 from .layout import AFFINE, KEY, LARGEST
 
 __all__ = ["register", "unregister", "spectrum", "workspace", "cache_new", "operators_at",
@@ -86,18 +87,6 @@ def _lapack_eigvals(op, out):
     out[...] = np.linalg.eigvals(op)
 
 
-def _lapack_eig(op, vals, vecs, inv):
-    """LAPACK's eigen-decomposition and the inverse of the eigenvectors; 0 where that is singular."""
-    v, w = np.linalg.eig(op)
-    vals[...] = v
-    vecs[...] = w
-    try:
-        inv[...] = np.linalg.inv(w)
-    except np.linalg.LinAlgError:
-        return 0
-    return 1 if np.isfinite(inv).all() else 0
-
-
 # -- compiled ----------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
 def _provided_operators(key, loads, out):
@@ -123,7 +112,7 @@ def _lapack_values(op, out):
 @njit(cache=True, error_model="numpy")
 def _lapack_vectors(op, vals, vecs, inv):
     with objmode(status="int64"):
-        status = _lapack_eig(op, vals, vecs, inv)
+        status = lapack_eig(op, vals, vecs, inv)
     return status
 
 
