@@ -218,14 +218,18 @@ def practical_rows(res) -> list[tuple[str, str]]:
     else:
         value = f"{_num(p.load, 'N', 10)} ({p.kind}, {_num(p.frequency_hz)} Hz)"
     rows.append(("practical critical thrust", value))
-    if res.practical_margin is not None:
-        margin = _num(res.practical_margin, "", 4)
-    elif res.operating_thrust is None:
-        margin = "needs an operating thrust"
-    else:
-        margin = f"> {res.thrust_max / res.operating_thrust:.4g} (threshold kept up to thrust_max)"
-    rows.append(("practical margin", margin))
+    rows.append(("practical margin", _margin_text(res.practical_margin, res, "threshold kept up to thrust_max")))
     return rows
+
+
+def _margin_text(margin: float | None, res, beyond: str) -> str:
+    """A margin's cell: its value, or why there is none (no operating thrust; no onset up to
+    ``thrust_max``, then a lower bound with ``beyond`` saying what held that far)."""
+    if margin is not None:
+        return _num(margin, "", 4)
+    if res.operating_thrust is None:
+        return "needs an operating thrust"
+    return f"> {res.thrust_max / res.operating_thrust:.4g} ({beyond})"
 
 
 def critical_rows(res, damped: bool | None = None) -> list[tuple[str, str]]:
@@ -242,13 +246,7 @@ def critical_rows(res, damped: bool | None = None) -> list[tuple[str, str]]:
         rows.append(("frequency", f"{_num(res.frequency_hz)} Hz ({_num(res.omega)} rad/s)"))
         rows.append(("modes involved", ", ".join(res.modes)))
     rows.append(("operating thrust", _num(res.operating_thrust, "N", missing="not given (thrust.operating)")))
-    if res.margin is not None:
-        margin = _num(res.margin, "", 4)
-    elif res.operating_thrust is None:
-        margin = "needs an operating thrust"
-    else:
-        margin = f"> {res.thrust_max / res.operating_thrust:.4g} (stable up to thrust_max)"
-    rows.append(("margin (critical / operating)", margin))
+    rows.append(("margin (critical / operating)", _margin_text(res.margin, res, "stable up to thrust_max")))
     same = res.undamped_thrust == res.thrust and res.undamped_kind == res.kind
     if damped is False or (damped is None and same):
         und = "same as the critical thrust (no dampers)" if damped is False else "same as the critical thrust"
