@@ -7,6 +7,8 @@ impstab, each in a fresh process (median of ``--repeat`` runs; wall time and the
 user + sys, which a loaded machine disturbs less):
 
 * ``impstab --version``, ``impstab --help``;
+  (``python -m impstab.precompile`` runs first: kernels in the cache and impstab's bytecode written,
+  as a second run of any command finds them; the baseline's libraries have theirs from ``pip``)
 * ``impstab critical examples/imp_symmetric.toml --json``, warm (its kernels in the cache), and
   the same with ``IMPSTAB_JIT=compiled`` (numba imported and the kernels loaded from the cache,
   which is what every run paid before single-model analyses ran their kernels interpreted, see

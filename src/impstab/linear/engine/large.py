@@ -29,8 +29,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as sla
-import scipy.sparse as sparse
-import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from ..classify import classify_eigenvalues
@@ -60,6 +58,8 @@ def reducible(problem) -> bool:
 
 
 def _sparse_or_dense(a: Array):
+    import scipy.sparse as sparse  # only large systems need it (about 0.1 s of import)
+
     return sparse.csc_matrix(a) if np.count_nonzero(a) < 0.1 * a.size else a
 
 
@@ -71,6 +71,8 @@ def modal_basis(problem, m: int) -> tuple[Array, Array]:
         w, phi = sla.eigh(k0, mass)
     else:
         start = mass @ np.linspace(1.0, 2.0, n)  # a fixed start: the same basis on every run
+        import scipy.sparse.linalg as spla
+
         w, phi = spla.eigsh(_sparse_or_dense(k0), k=m, M=_sparse_or_dense(mass), sigma=0.0, which="LM", v0=start)
     order = np.argsort(w)
     w, phi = w[order], phi[:, order]
@@ -98,6 +100,9 @@ class _Pencil:
     def _factor(self, p: float, sigma: float):
         a = self.k0 + p * self.k1 - sigma * self.mass
         if self.sparse:
+            import scipy.sparse as sparse
+            import scipy.sparse.linalg as spla
+
             lu = spla.splu(sparse.csc_matrix(a))
             return lambda b, trans="N": lu.solve(b, trans=trans)
         lu = sla.lu_factor(a)
