@@ -504,13 +504,19 @@ def _conjugate_groups(lam: NDArray[np.complex128], vectors: NDArray | None = Non
         partner = np.argmin(np.where(np.isnan(dist), np.inf, dist), axis=-1)
         near = np.take_along_axis(dist, partner[..., None], axis=-1)[..., 0] <= _PAIR_TOL * scale
         if vectors is not None:
-            from .tracking import mac
-
             for r in range(lam.shape[0]):
                 cand = dist[r] <= _PAIR_TOL * scale                      # (a, b)
-                if (cand.sum(axis=1) > 1).any():
-                    fit = np.where(cand, mac(np.conj(vectors[r]), vectors[r]), -1.0)
-                    partner[r] = np.argmax(fit, axis=1)
+                multi = cand.sum(axis=1) > 1
+                if multi.any():
+                    # the MAC of conj(v_a) and v_b, for the candidate pairs only (a column
+                    # with one candidate keeps it: the nearest conjugate)
+                    a, b = np.nonzero(cand & multi[:, None])
+                    va, vb = vectors[r][:, a], vectors[r][:, b]
+                    num = np.abs((va * vb).sum(axis=0)) ** 2
+                    den = (np.abs(va) ** 2).sum(axis=0) * (np.abs(vb) ** 2).sum(axis=0)
+                    fit = np.full(cand.shape, -1.0)
+                    fit[a, b] = num / np.where(den > 0, den, 1.0)
+                    partner[r, multi] = np.argmax(fit[multi], axis=1)
         upper = lam.imag > _PAIR_TOL * scale
     first = np.broadcast_to(np.arange(k), partner.shape)
     linked = upper & near & (partner != first)
