@@ -1,7 +1,8 @@
 """Start-up: how soon impstab answers, against the interpreter importing its own base, same run.
 
 Baseline: ``python -c "import numpy, scipy.linalg, pydantic"``, what any tool of this kind pays
-before it computes anything (the goal: a warm ``critical --json`` within 2x of it).
+before it computes anything (the goal: a warm ``critical --json`` within 2x of it), run with the
+BLAS thread count impstab's command line sets (:mod:`impstab._blas`).
 
 impstab, each in a fresh process (median of ``--repeat`` runs; wall time and the child's CPU time,
 user + sys, which a loaded machine disturbs less):
@@ -38,6 +39,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from impstab._blas import prefer_single_thread
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "imp_symmetric.toml"
 BASELINE = [sys.executable, "-c", "import numpy, scipy.linalg, pydantic"]
@@ -63,6 +66,10 @@ def run(argv: list[str], env: dict | None = None) -> tuple[float, float, subproc
 
 
 COMPILED = {**os.environ, "IMPSTAB_JIT": "compiled"}
+#: the baseline's environment: the BLAS thread count impstab's command line sets (impstab._blas),
+#: so that both import numpy's BLAS alike
+SINGLE_THREAD = dict(os.environ)
+prefer_single_thread(SINGLE_THREAD)
 OTHER_EXAMPLES = ["imp_asymmetric", "imp_damped", "imp_fluid", "imp_viscoelastic", "imp_beam_mounts",
                   "imp_hardening"]
 
@@ -158,7 +165,7 @@ def main() -> int:
 
     print(f"warm start-up, median of {args.repeat} fresh processes (shared machine: see the cpu column too)")
     rows = {
-        "baseline": ("python -c 'import numpy, scipy.linalg, pydantic'", BASELINE),
+        "baseline": ("python -c 'import numpy, scipy.linalg, pydantic'", BASELINE, SINGLE_THREAD),
         "python": ("python -c pass", [sys.executable, "-c", "pass"]),
         "version": ("impstab --version", [*impstab, "--version"]),
         "help": ("impstab --help", [*impstab, "--help"]),

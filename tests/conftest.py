@@ -4,7 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pytest
+from impstab._blas import prefer_single_thread
+
+prefer_single_thread()  # as the command line does, before numpy loads (see impstab._blas)
+
+import pytest  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"

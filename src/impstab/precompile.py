@@ -234,6 +234,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="remove impstab's compiled kernels (every cache folder of this environment) and stop")
     args = parser.parse_args(argv)
 
+    from ._blas import prefer_single_thread
+
+    prefer_single_thread()  # as the commands run (and before numpy loads, see impstab._blas)
     _numba_cache.install()
     # compile from the first call here and in the worker processes (a single-model command would
     # otherwise run its kernels interpreted, see impstab._jit, and compile nothing)

@@ -125,6 +125,9 @@ def cli() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Console entry point; returns the exit code."""
+    from .._blas import prefer_single_thread
+
+    prefer_single_thread()  # before numpy loads (see impstab._blas)
     code = run_guarded(cli, argv)
     if argv is None:
         sys.exit(code)
