@@ -132,6 +132,8 @@ def cases(folder: Path) -> list[tuple[str, list[str]]]:
     models = _models(folder)
     sym = str(models["symmetric"])
     out: list[tuple[str, list[str]]] = []
+    # every case but one on each model: the massive beam mounts' --all-crossings compiles nothing
+    # the plain case has not (the same large-model route) and takes seconds of dense eigenproblems
     for name, path in models.items():
         p = str(path)
         runs = [
@@ -146,7 +148,8 @@ def cases(folder: Path) -> list[tuple[str, list[str]]]:
             (f"response {name}", ["response", p, "--frequencies", "1:40:16", "--json"]),
         ]
         refused = _refused(path)
-        out += [(label, argv) for label, argv in runs if argv[0] not in refused]
+        out += [(label, argv) for label, argv in runs
+                if argv[0] not in refused and not (name == "beam_mounts" and "--all-crossings" in argv)]
     for integrator in ("gill", "dop853", "rk45", "radau", "lsoda"):
         out.append((f"simulate {integrator}", ["simulate", sym, "--thrust", "19000", "--duration", "0.05",
                                              "--integrator", integrator, "--no-plot", "-o", str(folder / "sim.csv")]))
