@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.mount_law import N_LAW
-from .rhs import (FLAG_LAW, FLAG_ROTATION, KIND_LINEAR, KIND_MODEL, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH,
+from .rhs import (FLAG_LAW, FLAG_ROTATION, KIND_LINEAR, KIND_MODEL, N_BODY, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH,
                   P_RADIATION, P_ROTATION, P_RT, P_TANG, PITCH_LIMIT, mount_loads_series, rhs_batch, rhs_into)
 
 __all__ = ["DynamicSystem", "NonlinearSystem", "pack_dynamics", "linear_dynamics", "evaluate_rhs", "mount_loads",
@@ -32,9 +32,10 @@ COMPLEX_STEP = 1e-30
 class DynamicSystem:
     """A system packed for the compiled kernels.
 
-    ``kind = 0``: the propulsor model (12 states); ``kind = 1``: a linear system ``z' = A z``
-    (used to test the integrators on oscillators). ``arrays`` is the tuple handed to the kernels;
-    ``length_scale`` (m) is the model's largest mount or thrust arm.
+    ``kind = 0``: the propulsor model (12 states, then 3 per Prony term of its viscoelastic
+    mounts); ``kind = 1``: a linear system ``z' = A z`` (used to test the integrators on
+    oscillators). ``arrays`` is the tuple handed to the kernels; ``length_scale`` (m) is the
+    model's largest mount or thrust arm.
     """
 
     kind: int
@@ -43,9 +44,28 @@ class DynamicSystem:
     n_mounts: int
     length_scale: float = 1.0
 
+    @property
+    def n_terms(self) -> int:
+        """Number of Prony terms (internal 3-vectors, states ``12 + 3 j : 15 + 3 j``)."""
+        return int(self.arrays[10].shape[0])
+
+    @property
+    def term_mounts(self) -> NDArray[np.int64]:
+        """The mount of each Prony term (index into the model's mounts)."""
+        start = np.asarray(self.arrays[9])
+        return np.repeat(np.arange(start.size - 1), np.diff(start))
+
+    def internal_equilibrium(self, displacement, rotation) -> NDArray[np.float64]:
+        """The internal variables at rest ``w_ij = d_i`` (``(3 n_terms,)``, m, hull frame) for the
+        body at ``displacement`` (m) and ``rotation`` (3 x 3, body -> hull)."""
+        pos = np.asarray(self.arrays[0])[self.term_mounts]
+        d = np.asarray(displacement, float)[None] + pos @ np.asarray(rotation, float).T - pos
+        return d.reshape(-1)
+
 
 def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
-    """Pack ``model`` for the kernels: mounts, mass properties, thrust line, propeller."""
+    """Pack ``model`` for the kernels: mounts, mass properties, thrust line, propeller, and the
+    Prony terms of viscoelastic mounts (:attr:`~impstab.model.mounts.Mount.viscoelastic`)."""
     from ..linear.linearize import pack_model
     from ..linear.mount_dofs import refuse_massive_beams
 
@@ -69,12 +89,20 @@ def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
     par[P_PITCH] = float(pitch_limit)
     par[P_ROTATION] = float(any(rotational))
     par[P_RADIATION] = float(np.any(pk.damp6 != 0.0))
+    vstart = np.zeros(nm + 1, dtype=np.int64)
+    vpar = []
+    for i, m in enumerate(model.mounts):
+        law = m.viscoelastic
+        if law is not None:
+            vpar += list(zip(law.weights, law.relaxation_times))
+        vstart[i + 1] = len(vpar)
     arrays = (
         np.ascontiguousarray(pk.positions), np.ascontiguousarray(pk.stiffness),
         np.ascontiguousarray(pk.damping), flags, np.ascontiguousarray(pk.laws), par,
         np.ascontiguousarray(np.linalg.inv(pk.mass6)), np.ascontiguousarray(pk.damp6), np.zeros((1, 1)),
+        vstart, np.ascontiguousarray(np.array(vpar, dtype=float).reshape(-1, 2)),
     )
-    return DynamicSystem(KIND_MODEL, arrays, 12, nm, float(pk.length_scale))
+    return DynamicSystem(KIND_MODEL, arrays, N_BODY + 3 * len(vpar), nm, float(pk.length_scale))
 
 
 def linear_dynamics(amat) -> DynamicSystem:
@@ -82,7 +110,8 @@ def linear_dynamics(amat) -> DynamicSystem:
     amat = np.ascontiguousarray(amat, dtype=float)
     n = amat.shape[0]
     arrays = (np.zeros((0, 3)), np.zeros((0, 6, 6)), np.zeros((0, 6, 6)), np.zeros(0, dtype=np.int64),
-              np.zeros((0, N_LAW)), np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat)
+              np.zeros((0, N_LAW)), np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat,
+              np.zeros(1, dtype=np.int64), np.zeros((0, 2)))
     return DynamicSystem(KIND_LINEAR, arrays, n, 0)
 
 
@@ -142,7 +171,7 @@ class NonlinearSystem:
     def __post_init__(self) -> None:
         from ..model.viscoelastic import refuse_viscoelastic
 
-        refuse_viscoelastic(self.model, "the nonlinear time-domain model (simulate, postcritical)")
+        refuse_viscoelastic(self.model, "the post-critical analysis (postcritical)")
         object.__setattr__(self, "system", pack_dynamics(self.model, self.pitch_limit))
 
     @classmethod
