@@ -22,7 +22,7 @@ from .system import pack_dynamics
 from .result import SimulationResult
 from .viscoelastic import augmented_roots, check_explicit_step, step_limit
 
-__all__ = ["simulate", "check_work", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
+__all__ = ["simulate", "check_work", "check_step", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
 
 #: fixed steps per period of the fastest mode of the linearized system (Hamming's method is
 #: stable on the imaginary axis only for |h omega| below about 0.3; 40 steps give 0.157)
@@ -107,6 +107,16 @@ def _spin_law(model: Model) -> Callable:
     if prop.speed_law == "sqrt-thrust":
         return lambda t: prop.speed * np.sqrt(np.maximum(t, 0.0) / op)
     return lambda t: np.full(np.shape(t), prop.speed)
+
+
+def check_step(model: Model, thrust: float, integrator: str, dt: float | None, names: dict[str, str] | None = None) -> None:
+    """Refuse a fixed step ``dt`` (s) of ``hamming`` or ``gill`` beyond its stability limit on the
+    relaxation of viscoelastic internal variables at constant thrust ``thrust`` (N), before a run
+    (:func:`~impstab.dynamics.viscoelastic.check_explicit_step`); ``names`` as :func:`check_work`."""
+    if dt is None or not model.is_viscoelastic or not get_integrator(integrator).fixed_step:
+        return
+    _, _, rate = _fastest(model, linearize(model, float(thrust), "equilibrium"))
+    check_explicit_step(model, str(integrator).lower(), float(dt), rate, (names or PYTHON_NAMES)["dt"])
 
 
 #: the argument names of :func:`simulate` in the messages of :func:`check_work`
