@@ -117,3 +117,19 @@ def test_hamming_agrees_with_radau(example):
     assert np.allclose(ham.time, rad.time)
     assert np.max(np.abs(ham.deviation[:, :6] - rad.deviation[:, :6]) / scale) < 2e-6  # measured 2e-7
     assert np.max(np.abs(ham.internal_variables - rad.internal_variables)) < 5e-7 * np.max(scale[:3])
+
+
+def test_cli_refuses_a_stiff_explicit_step_in_one_line_and_writes_nothing(capsys, tmp_path):
+    from impstab.cli import main
+
+    out = tmp_path / "s.nc"
+    code = main(["simulate", str(EXAMPLES / "imp_viscoelastic.toml"), "--thrust", "1000", "--duration", "0.1",
+                 "--dt", "0.004", "-o", str(out)])
+    _, err = capsys.readouterr()
+    assert code == 2 and err.count("\n") == 1 and err.startswith("impstab: error: --dt = 0.004")
+    assert "radau" in err and "Traceback" not in err
+    assert not list(tmp_path.iterdir())
+    # the same step is fine for the implicit method (its largest step)
+    code = main(["simulate", str(EXAMPLES / "imp_viscoelastic.toml"), "--thrust", "1000", "--duration", "0.1",
+                 "--dt", "0.004", "--integrator", "radau", "--no-plot", "-o", str(out), "--json"])
+    assert code == 0 and out.exists()
