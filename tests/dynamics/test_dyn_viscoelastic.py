@@ -71,15 +71,16 @@ def test_stiff_relaxation_refused_for_explicit_steps_and_exact_with_radau():
             impstab.simulate(model, 0.0, 0.1, integrator, dt=1e-3, critical_thrust=False)
         text = str(err.value)
         assert err.value.field == "dt" and "\n" not in text and "radau" in text and "lsoda" in text
-    res = impstab.simulate(model, 0.0, 0.2, "radau", perturbation={"displacement": {"surge": x0}}, rtol=1e-10,
-                           critical_thrust=False)
-    x, _ = surge_closed_form(res.time, x0, s, tau)
-    assert res.completed and np.max(np.abs(res.deviation[:, 0] - x)) < 2e-6 * x0
+    for integrator, rtol in (("radau", 1e-9), ("lsoda", 1e-10)):  # measured 6e-10, 2e-8
+        res = impstab.simulate(model, 0.0, 0.2, integrator, perturbation={"displacement": {"surge": x0}}, rtol=rtol,
+                               critical_thrust=False)
+        x, _ = surge_closed_form(res.time, x0, s, tau)
+        assert res.completed and np.max(np.abs(res.deviation[:, 0] - x)) < 1e-7 * x0, integrator
     # the default explicit step resolves the relaxation: stable, and the same answer
     res = impstab.simulate(model, 0.0, 0.02, "hamming", perturbation={"displacement": {"surge": x0}},
                            critical_thrust=False)
     x, _ = surge_closed_form(res.time, x0, s, tau)
-    assert res.completed and res.dt * 1e5 < 0.7 and np.max(np.abs(res.deviation[:, 0] - x)) < 2e-6 * x0
+    assert res.completed and res.dt * 1e5 < 0.7 and np.max(np.abs(res.deviation[:, 0] - x)) < 1e-6 * x0
 
 
 def _least_stable(model, thrust):
