@@ -134,3 +134,17 @@ def test_cli_refuses_a_stiff_explicit_step_in_one_line_and_writes_nothing(capsys
     code = main(["simulate", str(EXAMPLES / "imp_viscoelastic.toml"), "--thrust", "1000", "--duration", "0.1",
                  "--dt", "0.004", "--integrator", "radau", "--no-plot", "-o", str(out), "--json"])
     assert code == 0 and out.exists()
+
+
+def test_step_between_accuracy_and_stability_limit_warns_and_runs():
+    from impstab.dynamics.simulate import StepSizeWarning
+    from impstab.dynamics.viscoelastic import augmented_roots
+
+    model = sls_ring(2.0, 1e-3)
+    rate = augmented_roots(model, 0.0).rate
+    assert 1e3 <= rate <= 2e3  # the relaxation root lies between 1 / tau and s / tau
+    with pytest.warns(StepSizeWarning, match="relaxation"):
+        res = impstab.simulate(model, 0.0, 0.05, "hamming", dt=0.5 / rate, critical_thrust=False,
+                               perturbation={"displacement": {"surge": 1e-3}})
+    x, _ = surge_closed_form(res.time, 1e-3, 2.0, 1e-3)
+    assert res.completed and np.max(np.abs(res.deviation[:, 0] - x)) < 1e-2 * 1e-3
