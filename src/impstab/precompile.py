@@ -117,12 +117,12 @@ def _with_lumped_hull(folder: Path, model: Path) -> Path:
 
 def _refused(path: Path) -> frozenset[str]:
     """The commands that refuse the model at ``path`` by design (one line, exit 2): beam mounts
-    with mass and viscoelastic mounts are carried by every linear analysis but not by the
-    nonlinear time histories."""
+    with mass are carried by every linear analysis but not by the nonlinear time histories and
+    the post-critical analysis."""
     from .model import load_model
 
     model = load_model(path)
-    if model.is_viscoelastic or any(m.is_massive_beam for m in model.mounts):
+    if any(m.is_massive_beam for m in model.mounts):
         return frozenset({"simulate", "postcritical"})
     return frozenset()
 

@@ -120,7 +120,8 @@ def _notes(results) -> list[str]:
               help="several thrusts T1,T2,... (N), one figure (e.g. sub-, at and supercritical)")
 @click.option("--duration", type=float, required=True, help="simulated time (s)")
 @click.option("--integrator", type=INTEGRATOR, default="hamming", show_default=True)
-@click.option("--dt", type=float, default=None, help="fixed step (s); default 40 steps per period of the fastest mode")
+@click.option("--dt", type=float, default=None, help="fixed step (s); default 40 steps per period of the fastest mode "
+                   "(and of the fastest relaxation of viscoelastic mounts)")
 @click.option("--sample", type=float, default=None, help="output sampling interval (s); default every step")
 @click.option("--tol", type=float, default=None, help="hamming: relative local error per step for step-size control")
 @click.option("--displace", multiple=True, metavar="DOF=VALUE", help="initial displacement (m, rad), repeatable")
@@ -141,7 +142,7 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     Figures 5-6, and reports the fitted envelope growth rate beside max Re(lambda) of the
     linearized system and the sub/at/supercritical classification.
     """
-    from ..dynamics.simulate import CLI_NAMES, check_work, default_step, simulate
+    from ..dynamics.simulate import CLI_NAMES, check_step, check_work, default_step, simulate
     from ..linear.critical_thrust import critical_thrust
     from ..model import load_model
 
@@ -169,6 +170,8 @@ def simulate_cmd(model_file, thrust, thrusts, duration, integrator, dt, sample, 
     if len(values) > 1 and sample is None:
         sample = dt * max(1, math.ceil(duration / dt / 100_000))
     check_work(model, [dt or steps[v] for v in values], duration, dt, sample, allow_long, CLI_NAMES)
+    for v in values:
+        check_step(model, v, integrator, dt, CLI_NAMES)
     results = []
     with _progress(sys.stderr.isatty() and not as_json) as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -43,6 +43,12 @@ class SimulationResult:
         What the run shows: envelope label, fitted growth rate beside ``max Re(lambda)`` at the
         same thrust, a limit cycle's period and amplitudes, or why it is undetermined.
     classification : {"subcritical", "critical", "supercritical", "unknown", "not computed"}
+    internal_variables : (k, n_terms, 3) or None
+        The internal variables ``w_ij`` of the viscoelastic mounts' Prony terms (m, hull frame;
+        at rest equal to the mount's deflection, :mod:`impstab.dynamics.viscoelastic`); None
+        without viscoelastic mounts.
+    internal_mounts : (n_terms,) int array or None
+        The mount of each Prony term.
     """
 
     time: Array
@@ -74,6 +80,8 @@ class SimulationResult:
     critical_thrust: float | None
     classification: str
     tolerances: dict = field(default_factory=dict)
+    internal_variables: Array | None = None
+    internal_mounts: Array | None = None
 
     @property
     def displacement(self) -> Array:
@@ -120,6 +128,14 @@ class SimulationResult:
                                {"units": "N", "long_name": "force of the mount on the body, hull frame"})
         data["mount_moment"] = (("time", "mount", "axis"), self.mount_loads[:, :, 3:],
                                 {"units": "N m", "long_name": "moment of the mount on the body (rotational stiffness)"})
+        coords_extra = {}
+        if self.internal_variables is not None:
+            data["internal_variable"] = (("time", "term", "axis"), self.internal_variables, {
+                "units": "m", "long_name": "viscoelastic internal variable of each Prony term, hull frame"})
+            coords_extra["term"] = ("term", np.arange(self.internal_variables.shape[1]),
+                                    {"units": "1", "long_name": "Prony term number"})
+            coords_extra["term_mount"] = ("term", np.asarray(self.internal_mounts),
+                                          {"units": "1", "long_name": "mount of each Prony term"})
         if self.error_estimate is not None:
             data["error_estimate"] = ("time", self.error_estimate, {
                 "units": "1", "long_name": "Hamming relative local error estimate (9/121)|p - c|"})
@@ -140,7 +156,7 @@ class SimulationResult:
                 attrs["growth_rate_linear"] = self.growth.linear_rate
         coords = {"time": ("time", self.time, {"units": "s", "long_name": "time"}),
                   "mount": ("mount", np.arange(self.mount_loads.shape[1]), {"units": "1", "long_name": "mount number"}),
-                  "axis": ("axis", ["x", "y", "z"], {"long_name": "hull-frame axis"})}
+                  "axis": ("axis", ["x", "y", "z"], {"long_name": "hull-frame axis"}), **coords_extra}
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     @classmethod
@@ -158,7 +174,9 @@ class SimulationResult:
         kw.update(time=ds["time"].values, deviation=dev, equilibrium=eq, thrust=ds["thrust"].values, mount_loads=loads,
                   error_estimate=ds["error_estimate"].values if "error_estimate" in ds else None,
                   perturbation=json.loads(a["perturbation"]), growth=growth, completed=bool(a["completed"]),
-                  tolerances=json.loads(a.get("tolerances", "{}")))
+                  tolerances=json.loads(a.get("tolerances", "{}")),
+                  internal_variables=ds["internal_variable"].values if "internal_variable" in ds else None,
+                  internal_mounts=ds["term_mount"].values if "term_mount" in ds.coords else None)
         return cls(**kw)
 
     def plot(self, ax=None):

@@ -16,6 +16,14 @@ with ``tau`` (body frame, moment about A) made of
   nonlinear law on the translation deflection ``d_i`` (cubic springs, snubber;
   :mod:`impstab.model.mount_law`). For the paper's mounts this is
   ``f_i = -k_i d_i - c_i d_i' - grad V_nl(d_i)`` at the body point;
+* viscoelastic mounts (:mod:`impstab.model.viscoelastic`): each Prony term j of mount i is an
+  internal 3-vector ``w_ij`` (hull frame, m), a state appended after the 12 of the body, with
+  ``tau_ij w_ij' = d_i - w_ij``; the mount's force gains ``-g_ij k_i (d_i - w_ij)`` at the body
+  point (``k_i`` its static translation stiffness). The Prony terms are linear in the
+  deflection and add to the elastic and nonlinear law above (which act on the static part), as
+  a Maxwell element in parallel with the mount: at rest ``w_ij = d_i`` and the static
+  equilibrium is the elastic one; linearized at it, the equations are those of
+  :mod:`impstab.linear.viscoelastic`;
 * the thrust ``T (eta_t R e + (1 - eta_t) e)`` at ``R r_T`` (follower part, fixed part);
 * the propeller gyroscopic moment ``-nu2 x h``, ``h = J_p Omega e`` (body frame);
 * the fluid radiation damping ``-D_A nu`` (zero for incompressible fluid loading).
@@ -59,7 +67,7 @@ from ..kinematics.so3 import _jinv_into, _log_so3_into
 from ..model.mount_law import law_gradient
 
 __all__ = ["rhs_into", "rhs_batch", "model_rhs", "mount_loads_series", "workspace", "PITCH_LIMIT",
-           "KIND_MODEL", "KIND_LINEAR", "FLAG_ROTATION", "FLAG_LAW"]
+           "KIND_MODEL", "KIND_LINEAR", "FLAG_ROTATION", "FLAG_LAW", "N_BODY"]
 
 #: default guard on the pitch angle (rad): the z-y-x Euler angles are singular at +-90 degrees
 PITCH_LIMIT = math.radians(85.0)
@@ -77,6 +85,9 @@ KIND_MODEL, KIND_LINEAR = 0, 1
 #: per-mount flags: the mount has rotational stiffness or damping (a 6 x 6 mount); it carries a
 #: nonlinear law
 FLAG_ROTATION, FLAG_LAW = 1, 2
+
+#: states of the body; the internal variables of viscoelastic mounts follow them
+N_BODY = 12
 
 #: length of the vector workspace: rotation vector (3), then the deflection and its rate (12)
 WS = 15
@@ -180,11 +191,34 @@ def _mount_load(i, pos, kmat, cmat, flags, laws, rot, jinv, ws, x0, x1, x2, vh0,
     return -g0, -g1, -g2, m0, m1, m2, rho0, rho1, rho2
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _prony_load(i, kmat, vstart, vpar, yeq, z, d0, d1, d2, out):
+    """Force of the Prony terms of mount ``i`` on the body (hull frame, N) at deflection ``d``,
+    and the rates ``w_ij' = (d - w_ij) / tau_ij`` of their internal variables into ``out``."""
+    f0 = f1 = f2 = 0.0 * d0
+    for j in range(vstart[i], vstart[i + 1]):
+        s = N_BODY + 3 * j
+        g, tau = vpar[j, 0], vpar[j, 1]
+        e0 = d0 - (yeq[s] + z[s])
+        e1 = d1 - (yeq[s + 1] + z[s + 1])
+        e2 = d2 - (yeq[s + 2] + z[s + 2])
+        out[s], out[s + 1], out[s + 2] = e0 / tau, e1 / tau, e2 / tau
+        f0 -= g * (kmat[i, 0, 0] * e0 + kmat[i, 0, 1] * e1 + kmat[i, 0, 2] * e2)
+        f1 -= g * (kmat[i, 1, 0] * e0 + kmat[i, 1, 1] * e1 + kmat[i, 1, 2] * e2)
+        f2 -= g * (kmat[i, 2, 0] * e0 + kmat[i, 2, 1] * e1 + kmat[i, 2, 2] * e2)
+    return f0, f1, f2
+
+
 @njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def model_rhs(pos, kmat, cmat, flags, laws, par, minv, damp6, yeq, z, thrust, spin, out, rot, jinv, ws):
+def model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, yeq, z, thrust, spin, out, rot, jinv,
+              ws):
     """``out = z'`` of the propulsor model at deviation ``z`` (thrust ``thrust`` N, spin
     ``spin`` rad/s), allocation-free: ``rot``, ``jinv`` and ``ws`` are the workspace of
     :func:`workspace` (of ``z``'s dtype; real or complex).
+
+    ``vstart (n_mounts + 1,)``: the Prony terms of mount i are ``vstart[i]:vstart[i + 1]``;
+    ``vpar (n_terms, 2)``: their weight ``g`` and relaxation time ``tau`` (s); their internal
+    variables are the states ``12 + 3 j : 15 + 3 j``.
 
     Returns a status: 0, or 2 when ``|Re theta|`` reached the pitch guard (the derivative is
     still computed unless ``cos(theta)`` vanishes).
@@ -195,7 +229,7 @@ def model_rhs(pos, kmat, cmat, flags, laws, par, minv, damp6, yeq, z, thrust, sp
     if abs(theta.real) >= par[P_PITCH]:
         status = PITCH
         if abs(ct.real) < 1e-12:
-            for i in range(12):
+            for i in range(out.shape[0]):
                 out[i] = math.nan
             return status
     _pose_into(par, yeq, z, rot, jinv, ws)
@@ -216,6 +250,12 @@ def model_rhs(pos, kmat, cmat, flags, laws, par, minv, damp6, yeq, z, thrust, sp
     for i in range(pos.shape[0]):
         l0, l1, l2, l3, l4, l5, rho0, rho1, rho2 = _mount_load(
             i, pos, kmat, cmat, flags, laws, rot, jinv, ws, x0, x1, x2, vh0, vh1, vh2, wh0, wh1, wh2)
+        if vstart[i + 1] > vstart[i]:
+            v0, v1, v2 = _prony_load(i, kmat, vstart, vpar, yeq, z, x0 + rho0 - pos[i, 0], x1 + rho1 - pos[i, 1],
+                                     x2 + rho2 - pos[i, 2], out)
+            l0 += v0
+            l1 += v1
+            l2 += v2
         c0, c1, c2 = _cross3(rho0, rho1, rho2, l0, l1, l2)
         f0 += l0
         f1 += l1
@@ -311,8 +351,8 @@ def rhs_into(kind, arrays, yeq, z, thrust, spin, out):
     if kind == KIND_LINEAR:
         return linear_rhs(arrays[8], z, out)
     rot, jinv, ws = workspace(z)
-    return model_rhs(arrays[0], arrays[1], arrays[2], arrays[3], arrays[4], arrays[5], arrays[6], arrays[7],
-                     yeq, z, thrust, spin, out, rot, jinv, ws)
+    return model_rhs(arrays[0], arrays[1], arrays[2], arrays[3], arrays[4], arrays[9], arrays[10], arrays[5],
+                     arrays[6], arrays[7], yeq, z, thrust, spin, out, rot, jinv, ws)
 
 
 @njit(cache=True, error_model="numpy", compile_first=True)
@@ -324,20 +364,24 @@ def rhs_batch(kind, arrays, yeq, zs, thrust, spin, out, status):
     rot, jinv, ws = workspace(zs[0])
     pos, kmat, cmat, flags, laws = arrays[0], arrays[1], arrays[2], arrays[3], arrays[4]
     par, minv, damp6, amat = arrays[5], arrays[6], arrays[7], arrays[8]
+    vstart, vpar = arrays[9], arrays[10]
     for k in range(zs.shape[0]):
         if kind == KIND_LINEAR:
             status[k] = linear_rhs(amat, zs[k], out[k])
         else:
-            status[k] = model_rhs(pos, kmat, cmat, flags, laws, par, minv, damp6, yeq, zs[k], thrust, spin, out[k],
-                                  rot, jinv, ws)
+            status[k] = model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, yeq, zs[k], thrust,
+                                  spin, out[k], rot, jinv, ws)
 
 
 @njit(cache=True, error_model="numpy", compile_first=True)
 def mount_loads_series(arrays, yeq, zs, out):
     """Mount forces (hull frame, N) and mount moments (N m) on the body for each state row of
-    ``zs``; ``out`` has shape ``(n_samples, n_mounts, 6)``."""
+    ``zs``, the Prony terms of viscoelastic mounts included; ``out`` has shape
+    ``(n_samples, n_mounts, 6)``."""
     pos, kmat, cmat, flags, laws, par = arrays[0], arrays[1], arrays[2], arrays[3], arrays[4], arrays[5]
+    vstart, vpar = arrays[9], arrays[10]
     rot, jinv, ws = workspace(yeq)
+    rates = np.zeros(yeq.shape[0])
     for k in range(zs.shape[0]):
         z = zs[k]
         _pose_into(par, yeq, z, rot, jinv, ws)
@@ -349,3 +393,8 @@ def mount_loads_series(arrays, yeq, zs, out):
                                wh0, wh1, wh2)
             for a in range(6):
                 out[k, i, a] = load[a]
+            if vstart[i + 1] > vstart[i]:
+                v = _prony_load(i, kmat, vstart, vpar, yeq, z, x0 + load[6] - pos[i, 0], x1 + load[7] - pos[i, 1],
+                                x2 + load[8] - pos[i, 2], rates)
+                for a in range(3):
+                    out[k, i, a] += v[a]

@@ -17,10 +17,12 @@ from .growth import classify, fit_run
 from .integrators import Problem, get_integrator
 from .loading import Perturbation, as_thrust_history
 from .rhs import PITCH_LIMIT
+from .rhs import N_BODY
 from .system import pack_dynamics
 from .result import SimulationResult
+from .viscoelastic import augmented_roots, check_explicit_step, step_limit
 
-__all__ = ["simulate", "check_work", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
+__all__ = ["simulate", "check_work", "check_step", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
 
 #: fixed steps per period of the fastest mode of the linearized system (Hamming's method is
 #: stable on the imaginary axis only for |h omega| below about 0.3; 40 steps give 0.157)
@@ -78,12 +80,26 @@ def fastest_mode(lin, model: Model | None = None) -> tuple[float, str]:
     return omega, mode
 
 
+def _fastest(model: Model, lin) -> tuple[float, str, float]:
+    """``(omega (rad/s), dominant dof, rate (1/s))``: the fastest mode of ``lin`` (snubbers in
+    contact included, :func:`fastest_mode`) and, with viscoelastic mounts, of the augmented
+    system with their internal variables, and its fastest real relaxation root (0 without)."""
+    omega, mode = fastest_mode(lin, model)
+    if not model.is_viscoelastic:
+        return omega, mode, 0.0
+    roots = augmented_roots(model, lin.thrust)
+    if roots.omega > omega:
+        omega, mode = roots.omega, roots.mode
+    return omega, mode, roots.rate
+
+
 def default_step(model: Model, thrust: float) -> float:
     """Default fixed step (s) at constant thrust ``thrust`` (N): ``STEPS_PER_PERIOD`` per period of
     the fastest mode of the system linearized at the static equilibrium (with its snubbers in
-    full contact, when it has any)."""
-    omega, _ = fastest_mode(linearize(model, float(thrust), "equilibrium"), model)
-    return 2 * math.pi / (STEPS_PER_PERIOD * omega)
+    full contact, when it has any) and per ``2 pi / rate`` of the fastest relaxation of the
+    viscoelastic internal variables (:mod:`impstab.dynamics.viscoelastic`)."""
+    omega, _, rate = _fastest(model, linearize(model, float(thrust), "equilibrium"))
+    return step_limit(omega, rate, STEPS_PER_PERIOD)
 
 
 def _spin_law(model: Model) -> Callable:
@@ -91,6 +107,16 @@ def _spin_law(model: Model) -> Callable:
     if prop.speed_law == "sqrt-thrust":
         return lambda t: prop.speed * np.sqrt(np.maximum(t, 0.0) / op)
     return lambda t: np.full(np.shape(t), prop.speed)
+
+
+def check_step(model: Model, thrust: float, integrator: str, dt: float | None, names: dict[str, str] | None = None) -> None:
+    """Refuse a fixed step ``dt`` (s) of ``hamming`` or ``gill`` beyond its stability limit on the
+    relaxation of viscoelastic internal variables at constant thrust ``thrust`` (N), before a run
+    (:func:`~impstab.dynamics.viscoelastic.check_explicit_step`); ``names`` as :func:`check_work`."""
+    if dt is None or not model.is_viscoelastic or not get_integrator(integrator).fixed_step:
+        return
+    _, _, rate = _fastest(model, linearize(model, float(thrust), "equilibrium"))
+    check_explicit_step(model, str(integrator).lower(), float(dt), rate, (names or PYTHON_NAMES)["dt"])
 
 
 #: the argument names of :func:`simulate` in the messages of :func:`check_work`
@@ -107,7 +133,7 @@ def check_work(model: Model, step_sizes: list[float], duration: float, dt: float
     :data:`~impstab.limits.MAX_STEPS` (``allow_long``: :data:`~impstab.limits.LONG_FACTOR` times
     more). The samples of a run are every step, at most :data:`MAX_SAMPLES` of them, unless
     ``sample`` is given; each takes 8 bytes for the time, the 12 states, the thrust, the error
-    estimate and the 6 loads of every mount, twice (the run and a file written from it); they may
+    estimate, the 6 loads of every mount and the viscoelastic internal variables, twice (the run and a file written from it); they may
     take at most :data:`~impstab.limits.MAX_OUTPUT_BYTES`. ``names`` gives the argument names the
     messages use (``dt``, ``duration``, ``sample``, ``allow_long``).
     """
@@ -121,7 +147,8 @@ def check_work(model: Model, step_sizes: list[float], duration: float, dt: float
             " with a progress bar" if names is CLI_NAMES else "")
         raise ModelError(field, dt if dt is not None else duration,
                          f"would need {describe_count(total)} time steps (limit {describe_count(limit)}){hint}")
-    per_sample = 8 * 2 * (15 + 6 * len(model.mounts))
+    internal = 3 * sum(m.viscoelastic.n_terms for m in model.mounts if m.viscoelastic is not None)
+    per_sample = 8 * 2 * (15 + 6 * len(model.mounts) + internal)
     samples = sum(math.ceil(duration / sample) if sample is not None else min(math.ceil(duration / h), MAX_SAMPLES)
                   for h in step_sizes)
     if samples * per_sample > MAX_OUTPUT_BYTES:
@@ -185,9 +212,6 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
     -------
     SimulationResult
     """
-    from ..model.viscoelastic import refuse_viscoelastic
-
-    refuse_viscoelastic(model, "the nonlinear time histories (simulate)")
     duration = _finite("duration", duration)
     history = as_thrust_history(thrust)
     solver = get_integrator(integrator)
@@ -205,29 +229,37 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
     lin = linearize(model, t0_thrust, "equilibrium")
     system = pack_dynamics(model, pitch_limit)
     length = system.length_scale
-    yeq = np.zeros(12)
+    yeq = np.zeros(system.n_states)
     yeq[:3] = lin.displacement
     yeq[3:6] = matrix_to_euler_zyx(lin.rotation)
-    z0 = pert.vector
+    # viscoelastic internal variables at rest: w_ij = d_i (the static deflection carries the load)
+    yeq[N_BODY:] = system.internal_equilibrium(lin.displacement, lin.rotation)
+    z0 = np.zeros(system.n_states)
+    z0[:N_BODY] = pert.vector
     if abs(yeq[4] + z0[4]) >= pitch_limit:
         raise ModelError("perturbation.displacement.pitch", z0[4], "initial pitch must stay below pitch_limit")
-    # step from the fastest mode (at T(0), and at the extreme thrusts of a history)
-    omega, mode = fastest_mode(lin, model)
+    # step from the fastest mode and relaxation (at T(0), and at the extreme thrusts of a history)
+    omega, mode, rate = _fastest(model, lin)
     t_probe = history(np.linspace(0.0, duration, 257))
     for t_other in (float(np.max(t_probe)), float(np.min(t_probe))):
         if abs(t_other - t0_thrust) > 1e-6 * max(abs(t0_thrust), 1.0):
             try:
-                om, md = fastest_mode(linearize(model, t_other, "equilibrium"), model)
+                om, md, rt = _fastest(model, linearize(model, t_other, "equilibrium"))
             except Exception:  # noqa: BLE001 - no equilibrium there: keep the value at T(0)
                 continue
             if om > omega:
                 omega, mode = om, md
-    h_limit = 2 * math.pi / (STEPS_PER_PERIOD * omega)
-    if solver.fixed_step and dt is not None and dt > h_limit * (1 + 1e-9):
-        warnings.warn(
-            f"dt = {dt:.4g} s is larger than the limit {h_limit:.4g} s for the fastest mode ({mode}, "
-            f"{omega / (2 * math.pi):.4g} Hz): use at least {STEPS_PER_PERIOD} steps per period, or the "
-            f"integrator's own growth can look like flutter", StepSizeWarning, stacklevel=2)
+            rate = max(rate, rt)
+    h_limit = step_limit(omega, rate, STEPS_PER_PERIOD)
+    if solver.fixed_step and dt is not None:
+        check_explicit_step(model, solver.name, dt, rate)
+        if dt > h_limit * (1 + 1e-9):
+            what = (f"the fastest mode ({mode}, {omega / (2 * math.pi):.4g} Hz)" if omega >= rate else
+                    f"the fastest relaxation of the viscoelastic internal variables ({rate:.4g} 1/s)")
+            warnings.warn(
+                f"dt = {dt:.4g} s is larger than the limit {h_limit:.4g} s for {what}: use at least "
+                f"{STEPS_PER_PERIOD} steps per period, or the integrator's own growth can look like flutter",
+                StepSizeWarning, stacklevel=2)
     h = dt if dt is not None else h_limit
     check_work(model, [h], duration, dt, sample, allow_long)
     if sample is None:
@@ -243,7 +275,9 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
         tt = np.asarray(history(t), dtype=float)
         return np.vstack([tt, spin(tt)])
 
-    weights = np.array([1, 1, 1, length, length, length] + [1 / omega] * 3 + [length / omega] * 3)
+    # error weights make every state a length; the internal variables are lengths (m)
+    weights = np.array([1, 1, 1, length, length, length] + [1 / omega] * 3 + [length / omega] * 3
+                       + [1.0] * (system.n_states - N_BODY))
     # absolute tolerance (in metres after weighting): rtol x the initial deviation, floored at
     # 1e-15 x the length scale, where the rounding of the absolute state (eps x |y_eq|) takes over
     scale = max(float(np.max(np.abs(weights * z0))), 1e-9 * length)
@@ -282,8 +316,14 @@ def _assemble(model, history, solver, problem, raw, lin, yeq, length, omega, mod
         offset = np.zeros(12)
         offset[:3] = lin_end.displacement - yeq[:3]
         offset[3:6] = np.asarray(matrix_to_euler_zyx(lin_end.rotation)) - yeq[3:6]
-    growth = fit_run(raw.time, raw.z, length, fit_window, linear_rate, t_end, omega_max=omega, offset=offset,
+    if lin_end is not None and model.is_viscoelastic:
+        linear_rate = augmented_roots(model, lin_end.thrust).max_real
+    body = raw.z[:, :N_BODY]
+    growth = fit_run(raw.time, body, length, fit_window, linear_rate, t_end, omega_max=omega, offset=offset,
                      thrusts=thrust_t)
+    internal = None
+    if raw.z.shape[1] > N_BODY:
+        internal = (yeq[None, N_BODY:] + raw.z[:, N_BODY:]).reshape(raw.z.shape[0], -1, 3)
     crit = None
     classification = "not computed"
     if critical_thrust is not False:
@@ -300,7 +340,7 @@ def _assemble(model, history, solver, problem, raw, lin, yeq, length, omega, mod
             crit = None if critical_thrust is None else float(critical_thrust)
             classification = classify(t_end, crit, model.analysis.thrust_max)
     return SimulationResult(
-        time=raw.time, deviation=raw.z, equilibrium=yeq, thrust=thrust_t, mount_loads=loads6,
+        time=raw.time, deviation=np.ascontiguousarray(body), equilibrium=yeq[:N_BODY].copy(), thrust=thrust_t, mount_loads=loads6,
         error_estimate=raw.error, model_name=model.name, integrator=solver.name, dt=problem.h,
         final_dt=raw.final_step, sample=problem.sample, duration=duration, thrust_history=history.describe(),
         perturbation=pert.to_dict(), completed=raw.completed, stop_reason=raw.reason, stop_time=raw.stop_time,
@@ -308,4 +348,6 @@ def _assemble(model, history, solver, problem, raw, lin, yeq, length, omega, mod
         fastest_omega=omega, fastest_mode=mode, step_limit=h_limit, length_scale=length, growth=growth,
         critical_thrust=crit, classification=classification,
         tolerances={"tol": problem.tol, "rtol": problem.rtol} if not solver.fixed_step or problem.tol else {},
+        internal_variables=internal,
+        internal_mounts=None if internal is None else problem.system.term_mounts.copy(),
     )

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.mount_law import N_LAW
-from .rhs import (FLAG_LAW, FLAG_ROTATION, KIND_LINEAR, KIND_MODEL, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH,
+from .rhs import (FLAG_LAW, FLAG_ROTATION, KIND_LINEAR, KIND_MODEL, N_BODY, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH,
                   P_RADIATION, P_ROTATION, P_RT, P_TANG, PITCH_LIMIT, mount_loads_series, rhs_batch, rhs_into)
 
 __all__ = ["DynamicSystem", "NonlinearSystem", "pack_dynamics", "linear_dynamics", "evaluate_rhs", "mount_loads",
@@ -32,9 +32,10 @@ COMPLEX_STEP = 1e-30
 class DynamicSystem:
     """A system packed for the compiled kernels.
 
-    ``kind = 0``: the propulsor model (12 states); ``kind = 1``: a linear system ``z' = A z``
-    (used to test the integrators on oscillators). ``arrays`` is the tuple handed to the kernels;
-    ``length_scale`` (m) is the model's largest mount or thrust arm.
+    ``kind = 0``: the propulsor model (12 states, then 3 per Prony term of its viscoelastic
+    mounts); ``kind = 1``: a linear system ``z' = A z`` (used to test the integrators on
+    oscillators). ``arrays`` is the tuple handed to the kernels; ``length_scale`` (m) is the
+    model's largest mount or thrust arm.
     """
 
     kind: int
@@ -43,9 +44,28 @@ class DynamicSystem:
     n_mounts: int
     length_scale: float = 1.0
 
+    @property
+    def n_terms(self) -> int:
+        """Number of Prony terms (internal 3-vectors, states ``12 + 3 j : 15 + 3 j``)."""
+        return int(self.arrays[10].shape[0])
+
+    @property
+    def term_mounts(self) -> NDArray[np.int64]:
+        """The mount of each Prony term (index into the model's mounts)."""
+        start = np.asarray(self.arrays[9])
+        return np.repeat(np.arange(start.size - 1), np.diff(start))
+
+    def internal_equilibrium(self, displacement, rotation) -> NDArray[np.float64]:
+        """The internal variables at rest ``w_ij = d_i`` (``(3 n_terms,)``, m, hull frame) for the
+        body at ``displacement`` (m) and ``rotation`` (3 x 3, body -> hull)."""
+        pos = np.asarray(self.arrays[0])[self.term_mounts]
+        d = np.asarray(displacement, float)[None] + pos @ np.asarray(rotation, float).T - pos
+        return d.reshape(-1)
+
 
 def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
-    """Pack ``model`` for the kernels: mounts, mass properties, thrust line, propeller."""
+    """Pack ``model`` for the kernels: mounts, mass properties, thrust line, propeller, and the
+    Prony terms of viscoelastic mounts (:attr:`~impstab.model.mounts.Mount.viscoelastic`)."""
     from ..linear.linearize import pack_model
     from ..linear.mount_dofs import refuse_massive_beams
 
@@ -69,12 +89,20 @@ def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
     par[P_PITCH] = float(pitch_limit)
     par[P_ROTATION] = float(any(rotational))
     par[P_RADIATION] = float(np.any(pk.damp6 != 0.0))
+    vstart = np.zeros(nm + 1, dtype=np.int64)
+    vpar = []
+    for i, m in enumerate(model.mounts):
+        law = m.viscoelastic
+        if law is not None:
+            vpar += list(zip(law.weights, law.relaxation_times))
+        vstart[i + 1] = len(vpar)
     arrays = (
         np.ascontiguousarray(pk.positions), np.ascontiguousarray(pk.stiffness),
         np.ascontiguousarray(pk.damping), flags, np.ascontiguousarray(pk.laws), par,
         np.ascontiguousarray(np.linalg.inv(pk.mass6)), np.ascontiguousarray(pk.damp6), np.zeros((1, 1)),
+        vstart, np.ascontiguousarray(np.array(vpar, dtype=float).reshape(-1, 2)),
     )
-    return DynamicSystem(KIND_MODEL, arrays, 12, nm, float(pk.length_scale))
+    return DynamicSystem(KIND_MODEL, arrays, N_BODY + 3 * len(vpar), nm, float(pk.length_scale))
 
 
 def linear_dynamics(amat) -> DynamicSystem:
@@ -82,7 +110,8 @@ def linear_dynamics(amat) -> DynamicSystem:
     amat = np.ascontiguousarray(amat, dtype=float)
     n = amat.shape[0]
     arrays = (np.zeros((0, 3)), np.zeros((0, 6, 6)), np.zeros((0, 6, 6)), np.zeros(0, dtype=np.int64),
-              np.zeros((0, N_LAW)), np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat)
+              np.zeros((0, N_LAW)), np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat,
+              np.zeros(1, dtype=np.int64), np.zeros((0, 2)))
     return DynamicSystem(KIND_LINEAR, arrays, n, 0)
 
 
@@ -117,6 +146,10 @@ class NonlinearSystem:
     of the body (rad), body-frame velocity of A (m/s) and angular velocity (rad/s). The thrust
     ``T`` (N) is the parameter; the propeller spin follows the model's speed law unless given.
 
+    With viscoelastic mounts the state goes on with the internal variables ``w_ij`` of their
+    Prony terms (3 each, hull frame, m; :mod:`impstab.dynamics.viscoelastic`): ``n_states`` is
+    ``12 + 3 n_terms``; at an equilibrium ``w_ij = d_i``.
+
     Every evaluation runs the compiled right-hand side of the simulation (one implementation),
     on real or complex128 states: the code is analytic in the state, so ``f`` of a complex state
     is the analytic continuation of ``f``, and complex-step or Cauchy-integral derivatives of it
@@ -140,38 +173,40 @@ class NonlinearSystem:
     system: DynamicSystem = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        from ..model.viscoelastic import refuse_viscoelastic
-
-        refuse_viscoelastic(self.model, "the nonlinear time-domain model (simulate, postcritical)")
         object.__setattr__(self, "system", pack_dynamics(self.model, self.pitch_limit))
 
     @classmethod
     def from_model(cls, model, pitch_limit: float = PITCH_LIMIT) -> "NonlinearSystem":
         return cls(model, pitch_limit)
 
-    n_states = 12
+    @property
+    def n_states(self) -> int:
+        """12, and 3 per Prony term of the viscoelastic mounts."""
+        return self.system.n_states
 
     def spin(self, thrust: float) -> float:
         """Propeller speed Omega (rad/s) at thrust ``thrust`` (N), by the model's speed law."""
         return float(self.model.propeller.spin(float(thrust), self.model.thrust.operating))
 
     def equilibrium(self, thrust: float) -> NDArray[np.float64]:
-        """The static equilibrium state at thrust ``thrust`` (N): ``(X_A, Xi, 0)`` (12,); the
-        continuation and Newton method of the linear analyses (:func:`equilibrium_state`)."""
-        return equilibrium_state(self.model, thrust)[0]
+        """The static equilibrium state at thrust ``thrust`` (N): ``(X_A, Xi, 0)`` (12,), then the
+        internal variables at rest (``w_ij = d_i``); the continuation and Newton method of the
+        linear analyses (:func:`equilibrium_state`)."""
+        y, lin = equilibrium_state(self.model, thrust)
+        return np.concatenate([y, self.system.internal_equilibrium(lin.displacement, lin.rotation)])
 
     def rhs(self, states, thrust: float, spin: float | None = None, deviation_from=None):
         """``f(y; T)`` at each state.
 
         Parameters
         ----------
-        states : (12,) or (n, 12) array, float or complex
+        states : (n_states,) or (n, n_states) array, float or complex
             Absolute states ``y``, or deviations from ``deviation_from`` when it is given.
         thrust : float
             Thrust T (N).
         spin : float, optional
             Propeller speed (rad/s); default the model's speed law at ``thrust``.
-        deviation_from : (12,) real array, optional
+        deviation_from : (n_states,) real array, optional
             A base state ``y0``: ``states`` are then ``y - y0`` (the integrators' form).
 
         Returns
@@ -181,9 +216,10 @@ class NonlinearSystem:
         states = np.asarray(states)
         cplx = np.iscomplexobj(states)
         zs = np.ascontiguousarray(np.atleast_2d(states), dtype=complex if cplx else float)
-        if zs.shape[-1] != 12 or zs.ndim != 2:
-            raise ValueError(f"states must have shape (12,) or (n, 12), not {states.shape}")
-        base = np.zeros(12) if deviation_from is None else np.ascontiguousarray(deviation_from, dtype=float)
+        ns = self.n_states
+        if zs.shape[-1] != ns or zs.ndim != 2:
+            raise ValueError(f"states must have shape ({ns},) or (n, {ns}), not {states.shape}")
+        base = np.zeros(ns) if deviation_from is None else np.ascontiguousarray(deviation_from, dtype=float)
         out = np.empty_like(zs)
         status = np.zeros(zs.shape[0], dtype=np.int64)
         spin = self.spin(thrust) if spin is None else float(spin)
@@ -191,13 +227,14 @@ class NonlinearSystem:
         return out.reshape(states.shape)
 
     def jacobian(self, states, thrust: float, spin: float | None = None, deviation_from=None):
-        """``df/dy`` at each state by complex step (exact to rounding): (12, 12) or (n, 12, 12)."""
+        """``df/dy`` at each state by complex step (exact to rounding): (m, m) or (n, m, m),
+        ``m = n_states``."""
         states = np.asarray(states, dtype=float)
         ys = np.atleast_2d(states)
-        n = ys.shape[0]
-        probe = np.repeat(ys[:, None, :], 12, axis=1).astype(complex)
-        probe[:, np.arange(12), np.arange(12)] += 1j * COMPLEX_STEP
-        f = self.rhs(probe.reshape(n * 12, 12), thrust, spin, deviation_from).reshape(n, 12, 12)
+        n, m = ys.shape[0], self.n_states
+        probe = np.repeat(ys[:, None, :], m, axis=1).astype(complex)
+        probe[:, np.arange(m), np.arange(m)] += 1j * COMPLEX_STEP
+        f = self.rhs(probe.reshape(n * m, m), thrust, spin, deviation_from).reshape(n, m, m)
         jac = np.swapaxes(f.imag, 1, 2) / COMPLEX_STEP
         return jac[0] if states.ndim == 1 else jac
 

@@ -272,4 +272,4 @@ def refuse_viscoelastic(model, what: str) -> None:
 
             raise ModelError(f"mounts[{i}].viscoelastic", m.viscoelastic.law,
                              f"{what} does not carry viscoelastic internal variables (not implemented); "
-                             "critical, modes, locus and response do")
+                             "critical, modes, locus, response and simulate do")

@@ -18,7 +18,11 @@ right-hand side of :func:`impstab.simulate`, through
 
 State scales (the unit of "small" of each state, which weighs the arclength and the derivative
 circles): ``0.01 L`` for the position of A, ``0.01`` rad for the angles, and those times the
-onset frequency for the velocities, ``L`` the model's largest mount or thrust arm.
+onset frequency for the velocities, ``L`` the model's largest mount or thrust arm. Viscoelastic
+mounts add their internal variables to the state (:mod:`impstab.dynamics.viscoelastic`,
+``w{j}_x, w{j}_y, w{j}_z`` for Prony term j, scaled like the position of A); the cycles'
+amplitudes, profiles and mount peaks are those of the body's 12 states, the Floquet multipliers
+those of the whole state.
 """
 
 from __future__ import annotations
@@ -71,13 +75,15 @@ def propulsor_system(model, omega: float | None = None) -> tuple[DynamicalSystem
     w = float(omega) if omega else 1.0
     xs = DEFAULTS["relative_position_scale"] * length
     an = DEFAULTS["angle_scale"]
-    scale = np.array([xs] * 3 + [an] * 3 + [w * xs] * 3 + [w * an] * 3)
+    n_internal = ns.n_states - 12  # viscoelastic internal variables (m): scaled like the position of A
+    scale = np.array([xs] * 3 + [an] * 3 + [w * xs] * 3 + [w * an] * 3 + [xs] * n_internal)
+    names = STATE_NAMES + tuple(f"w{j}_{a}" for j in range(n_internal // 3) for a in "xyz")
 
     def rhs(states, thrust):
         return ns.rhs(states, float(np.real(thrust)))
 
-    system = DynamicalSystem(rhs, 12, vectorized=True, complex_parameter=False, state_names=STATE_NAMES,
-                             state_units=STATE_UNITS, parameter_name="thrust", parameter_units="N",
+    system = DynamicalSystem(rhs, ns.n_states, vectorized=True, complex_parameter=False, state_names=names,
+                             state_units=STATE_UNITS + ("m",) * n_internal, parameter_name="thrust", parameter_units="N",
                              time_units="s", state_scale=scale, region=_regions(ns))
     return system, ns
 
@@ -133,7 +139,7 @@ def mount_peaks(ns, states: NDArray) -> tuple[float, float, bool]:
     rot = _rotations(states[:, 3], states[:, 4], states[:, 5])                  # (k, 3, 3)
     d = states[:, None, :3] + np.einsum("kab,ib->kia", rot, pos) - pos[None, :, :]
     dn = np.linalg.norm(d, axis=-1)                                              # (k, mounts)
-    loads = mount_loads(ns.system, np.zeros(12), states)
+    loads = mount_loads(ns.system, np.zeros(ns.n_states), states)
     force = np.linalg.norm(loads[:, :, :3], axis=-1)
     clearance = laws[:, LAW_CLEARANCE] if laws.size else np.zeros(pos.shape[0])
     contact = bool(np.any((clearance[None, :] > 0) & (dn > clearance[None, :])))

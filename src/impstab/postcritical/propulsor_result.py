@@ -66,7 +66,7 @@ class PostcriticalResult:
         equilibrium is stable there).
     branch_amplitude : (k, 6) array
         Half peak-to-peak of X_A, Y_A, Z_A (m) and phi, theta, psi (rad) over one period.
-    branch_multipliers : (k, 12) complex array
+    branch_multipliers : (k, n_states) complex array
         Floquet multipliers by decreasing modulus (the trivial one included).
     trivial_multiplier_error : (k,) array
         ``|mu_trivial - 1|`` of each cycle: the accuracy check of the multipliers.
@@ -136,7 +136,7 @@ class PostcriticalResult:
         tc = hopf.parameter
         stable = np.zeros(n, dtype=bool)
         stable[:len(cyc)] = branch.stable
-        mult = np.full((n, 12), np.nan + 0j)
+        mult = np.full((n, branch.multipliers.shape[1] if cyc else 12), np.nan + 0j)
         if cyc:
             mult[:len(cyc)] = branch.multipliers
         triv = np.concatenate([branch.trivial_error, np.full(len(missing), np.nan)])
@@ -275,7 +275,7 @@ class PostcriticalResult:
         prof = np.full((k, phases, 12), np.nan)
         if self.cycles is not None:
             for i, c in enumerate(self.cycles.cycles):
-                prof[i] = c.profile(tau)
+                prof[i] = c.profile(tau)[:, :12]  # the body's states (viscoelastic internal variables left out)
         from .propulsor import STATE_NAMES, STATE_UNITS
 
         data = {
@@ -313,7 +313,7 @@ class PostcriticalResult:
             v = _none(getattr(self, name))
             attrs[name] = math.nan if v is None else v
         coords = {"point": np.arange(k), "dof": list(DOFS), "phase": tau, "state": list(STATE_NAMES),
-                  "multiplier": np.arange(12)}
+                  "multiplier": np.arange(self.branch_multipliers.shape[1])}
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     # ------------------------------------------------------------------ drawing
