@@ -265,3 +265,55 @@ def test_reduced_family_drops_only_the_unreached_relaxation_roots():
 
     t_full = critical_load_family(full, 30000.0).load
     assert impstab.critical_thrust(model).thrust == pytest.approx(t_full, rel=1e-10)
+
+
+def test_reduced_states_in_dof_coordinates_are_the_exact_roots_and_keep_the_planes_apart():
+    """Three standard-linear-solid mounts (B of rank 6): the reduced family keeps one internal
+    6-vector in the body's dof coordinates, 18 states whose eigenvalues are the 18 roots of the exact
+    characteristic polynomial (companion pencil, _poly_roots), at a thrust with flutter and one
+    without; and its operator splits into the blocks of the symmetric layout (surge and roll with
+    their internal states, 3 each; the sway-yaw and heave-pitch planes, 6 each)."""
+    from impstab.linear.blocks import decoupled_blocks
+
+    model = _model(linearization="classical")
+    g, tau = 0.5, 2e-3
+    fam = ViscoelasticFamily(model, reduced=True)
+    assert fam.n == 18
+    for thrust in (4000.0, 29000.0):
+        lin = impstab.linearize(model, thrust, "classical")
+        roots = list(_poly_roots(lin, model.elastic_stiffness, g, tau))
+        e, a = fam.matrices(np.array([thrust]))
+        for lam in np.linalg.eigvals(np.linalg.solve(e[0], a[0])):
+            j = int(np.argmin(np.abs(np.array(roots) - lam)))
+            assert abs(roots[j] - lam) <= 1e-8 * max(abs(lam), 1.0), (lam, roots[j])
+            roots.pop(j)
+        assert not roots
+    e, a0, a1 = fam.affine_parts()
+    blocks = decoupled_blocks(np.linalg.solve(e, a0)[None], np.linalg.solve(e, a1)[None], np.array([30000.0]))
+    sizes = np.diff(blocks.starts[0, : blocks.nblocks[0] + 1])
+    assert sorted(sizes.tolist()) == [3, 3, 6, 6]
+
+
+def test_reduced_states_below_full_rank_drop_only_the_unreached_root():
+    """Two viscoelastic mounts of the asymmetric layout: their stacked maps have rank 5 (a rotation
+    about the line through them moves neither), so of the 6 internal states one combination is never
+    reached: the reduced family (an orthonormal basis of range B) has 17 states, every eigenvalue
+    of the full 18-state system but one, and that one is -1/tau."""
+    from conftest import asymmetric_model_dict
+
+    d = asymmetric_model_dict()
+    tau = 3e-3
+    for m in d["mounts"][:2]:
+        m["viscoelastic"] = {"law": "standard-linear-solid", "stiffening": 1.6, "relaxation_time": tau}
+    d["analysis"]["linearization"] = "classical"
+    model = model_from_dict(d)
+    full, small = ViscoelasticFamily(model), ViscoelasticFamily(model, reduced=True)
+    assert (full.n, small.n) == (18, 17)
+    e, a = full.matrices(np.array([3000.0]))
+    er, ar = small.matrices(np.array([3000.0]))
+    lam = list(np.linalg.eigvals(np.linalg.solve(e[0], a[0])))
+    for r in np.linalg.eigvals(np.linalg.solve(er[0], ar[0])):
+        j = int(np.argmin(np.abs(np.array(lam) - r)))
+        assert abs(lam[j] - r) <= 1e-8 * max(abs(r), 1.0)
+        lam.pop(j)
+    assert len(lam) == 1 and lam[0] == pytest.approx(-1 / tau, rel=1e-8)

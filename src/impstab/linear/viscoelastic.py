@@ -55,7 +55,28 @@ def _terms(model: Model):
     return out
 
 
-def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced: bool = False) -> tuple[Array, Array]:
+def _groups(terms) -> dict[float, list]:
+    """``{tau: [(mount index, static 3x3 k, g), ...]}``: the Prony terms that share a relaxation time."""
+    groups: dict[float, list] = {}
+    for i, kmount, g, tau in terms:
+        for gj, tj in zip(g, tau):
+            groups.setdefault(float(tj), []).append((i, kmount, float(gj)))
+    return groups
+
+
+def _reduced_ranks(positions: Array, terms) -> dict[float, int]:
+    """Rank of the stacked maps ``B`` of each relaxation time's mounts (at most 6; the same at every
+    thrust: the equilibrium only rotates the arms)."""
+    ranks = {}
+    for tj, members in _groups(terms).items():
+        b = np.concatenate([rigid_map(positions[i]) for i, _, _ in members], axis=0)
+        sv = np.linalg.svd(b, compute_uv=False)
+        ranks[tj] = int((sv > 1e-12 * sv[0]).sum())
+    return ranks
+
+
+def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced: bool = False,
+                       ranks: dict[float, int] | None = None) -> tuple[Array, Array]:
     """``E, A`` of the augmented state for stacks ``m, c = D + G, k (S, 6, 6)`` and arms ``rho (S, nm, 3)``.
 
     ``terms`` as :func:`_terms` returns. Returns ``E, A (S, N, N)``, ``N = 12 + 3 sum n_i``.
@@ -63,33 +84,43 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
     ``reduced``: the internal variables that share a relaxation time ``tau`` obey one equation
     ``tau z' = B q - z`` (``B`` the mounts' maps stacked): only ``z`` in the range of ``B`` (rank
     at most 6) is reached from the motion, the rest decays at ``-1/tau`` whatever the body does
-    (block-triangular form). Those are dropped: the states ``w = U^T z`` (``U`` an orthonormal
-    basis of range B, from an SVD) keep every other eigenvalue exactly, and the stability; the
-    dropped roots ``-1/tau`` are stable.
+    (block-triangular form). Those are dropped, every other eigenvalue is kept exactly, and the
+    stability; the dropped roots ``-1/tau`` are stable. Where ``B`` has full rank 6 (three mounts
+    or more, not on one line) the states kept are ``z = B zeta`` in the body's own dof coordinates:
+    ``tau zeta' = q - zeta``, with the force ``K_tau zeta``, ``K_tau = sum g B_i^T k_i B_i``. They
+    couple only the dofs the mounts' stiffness couples, so the operator keeps the decoupled blocks
+    of a symmetric layout (:mod:`impstab.linear.blocks`: the sway-yaw and heave-pitch planes apart,
+    each with its own internal states). Below rank 6 they are ``w = U^T z`` (``U`` an orthonormal
+    basis of range B, from an SVD). ``ranks``: those ranks by relaxation time
+    (:func:`_reduced_ranks`), where known; otherwise from the first stack with finite arms.
     """
     s = m.shape[0]
     kk = np.array(k, dtype=float, copy=True)
+    maps = {i: rigid_map(rho[:, i]) for i, _, _, _ in terms}                              # (S, 3, 6)
+    mount_k = {i: np.swapaxes(maps[i], -1, -2) @ kmount[None] for i, kmount, _, _ in terms}  # B_i^T k_i (S, 6, 3)
     blocks = []   # (rows from q (S, r, 6), force columns (S, 6, r), tau)
     if reduced:
-        groups: dict[float, list] = {}
-        for i, kmount, g, tau in terms:
-            for gj, tj in zip(g, tau):
-                groups.setdefault(float(tj), []).append((i, kmount, gj))
-        for tj, members in groups.items():
-            b = np.concatenate([rigid_map(rho[:, i]) for i, _, _ in members], axis=1)          # (S, 3m, 6)
-            cols = np.concatenate([gj * np.swapaxes(rigid_map(rho[:, i]), -1, -2) @ kmount[None]
-                                   for i, kmount, gj in members], axis=2)                     # (S, 6, 3m)
-            for i, kmount, gj in members:
-                bi = rigid_map(rho[:, i])
-                kk += gj * np.swapaxes(bi, -1, -2) @ kmount[None] @ bi
-            u, sv, _ = np.linalg.svd(np.where(np.isfinite(b), b, 0.0))
-            rank = int((sv[0] > 1e-12 * sv[0, :1]).sum())  # invariant under the rotation of the arms
-            u = u[:, :, :rank]
+        eye = np.broadcast_to(np.eye(6), (s, 6, 6))
+        for tj, members in _groups(terms).items():
+            b = np.concatenate([maps[i] for i, _, _ in members], axis=1)                    # (S, 3m, 6)
+            cols = np.concatenate([gj * mount_k[i] for i, _, gj in members], axis=2)       # (S, 6, 3m)
+            k_tau = cols @ b                                                              # (S, 6, 6)
+            kk += k_tau
+            finite = np.where(np.isfinite(b), b, 0.0)
+            if ranks is not None:
+                rank = ranks[tj]
+            else:  # invariant under the rotation of the arms
+                row = int(np.argmax(np.isfinite(b).all(axis=(1, 2))))
+                sv = np.linalg.svd(finite[row], compute_uv=False)
+                rank = int((sv > 1e-12 * sv[0]).sum())
+            if rank == 6:
+                blocks.append((eye, k_tau, tj))
+                continue
+            u = np.linalg.svd(finite)[0][:, :, :rank]
             blocks.append((np.swapaxes(u, -1, -2) @ b, cols @ u, tj))
     else:
         for i, kmount, g, tau in terms:
-            b = rigid_map(rho[:, i])                       # (S, 3, 6)
-            btk = np.swapaxes(b, -1, -2) @ kmount[None]    # (S, 6, 3)
+            b, btk = maps[i], mount_k[i]
             for gj, tj in zip(g, tau):
                 kk += gj * btk @ b
                 blocks.append((b, gj * btk, float(tj)))
@@ -167,17 +198,22 @@ class ViscoelasticFamily:
         object.__setattr__(self, "positions", np.array([mt.position for mt in self.model.mounts], dtype=float))
 
     @property
-    def n(self) -> int:
-        hit = self.__dict__.get("_n")
+    def ranks(self) -> dict[float, int] | None:
+        """Reduced families: the internal states kept per relaxation time (the rank of its mounts'
+        stacked maps; the same at every thrust, the equilibrium only rotates the arms)."""
+        if not self.reduced:
+            return None
+        hit = self.__dict__.get("_ranks")
         if hit is None:
-            if self.reduced:  # the ranks do not change with the thrust (a rotation of the arms)
-                rho = self.positions[None]  # type: ignore[attr-defined]
-                eye = np.eye(6)[None]
-                hit = int(augmented_matrices(eye, eye, eye, rho, self.terms, True)[1].shape[-1])  # type: ignore[attr-defined]
-            else:
-                hit = 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
-            object.__setattr__(self, "_n", hit)
+            hit = _reduced_ranks(self.positions, self.terms)  # type: ignore[attr-defined]
+            object.__setattr__(self, "_ranks", hit)
         return hit
+
+    @property
+    def n(self) -> int:
+        if self.reduced:
+            return 12 + sum(self.ranks.values())  # type: ignore[union-attr]
+        return 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
 
     @property
     def weights(self) -> Array:
@@ -198,7 +234,7 @@ class ViscoelasticFamily:
 
     def matrices(self, p: Array) -> tuple[Array, Array]:
         m, c, k, rho = self.system(p)
-        return augmented_matrices(m, c, k, rho, self.terms, self.reduced)  # type: ignore[attr-defined]
+        return augmented_matrices(m, c, k, rho, self.terms, self.reduced, self.ranks)  # type: ignore[attr-defined]
 
     def affine_parts(self):
         """``(E, A0, A1)`` when the elastic family is exactly affine with constant G, else None."""
@@ -207,7 +243,8 @@ class ViscoelasticFamily:
             return None
         m, d, g, k0, k1 = parts
         rho = self.positions[None]  # type: ignore[attr-defined]
-        e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms, self.reduced)  # type: ignore[attr-defined]
+        e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms, self.reduced,  # type: ignore[attr-defined]
+                                   self.ranks)
         a1 = np.zeros_like(a0[0])
         a1[6:12, :6] = -k1
         return e[0], a0[0], a1
