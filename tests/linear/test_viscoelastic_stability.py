@@ -317,3 +317,20 @@ def test_reduced_states_below_full_rank_drop_only_the_unreached_root():
         assert abs(lam[j] - r) <= 1e-8 * max(abs(r), 1.0)
         lam.pop(j)
     assert len(lam) == 1 and lam[0] == pytest.approx(-1 / tau, rel=1e-8)
+
+
+@pytest.mark.parametrize("dampers", [False, True])
+def test_undamped_companion_is_the_model_without_dampers_and_with_static_stiffness(dampers):
+    """The undamped critical thrust of a viscoelastic model, with or without viscous dampers beside
+    the laws, is that of model.undamped() (dampers removed, the mounts elastic at their static
+    stiffness), solved as an elastic model of its own."""
+    d = ring_model_dict()
+    d["mount_rings"][0]["viscoelastic"] = dict(SLS)
+    if dampers:
+        d["mount_rings"][0].update(c_axial=60.0, c_shear=15.0)
+    model = model_from_dict(d)
+    res = impstab.critical_thrust(model)
+    plain = impstab.critical_thrust(model.undamped())
+    assert not model.undamped().is_damped
+    assert res.undamped_thrust == pytest.approx(plain.thrust, rel=1e-12)
+    assert res.undamped_kind == plain.kind

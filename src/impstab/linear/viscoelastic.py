@@ -56,21 +56,29 @@ def _terms(model: Model):
 
 
 def _groups(terms) -> dict[float, list]:
-    """``{tau: [(mount index, static 3x3 k, g), ...]}``: the Prony terms that share a relaxation time."""
+    """``{tau: [(position in terms, g), ...]}``: the Prony terms that share a relaxation time."""
     groups: dict[float, list] = {}
-    for i, kmount, g, tau in terms:
+    for j, (_, _, g, tau) in enumerate(terms):
         for gj, tj in zip(g, tau):
-            groups.setdefault(float(tj), []).append((i, kmount, float(gj)))
+            groups.setdefault(float(tj), []).append((j, float(gj)))
     return groups
+
+
+def _mount_maps(rho: Array, terms) -> tuple[Array, Array, Array]:
+    """For the viscoelastic mounts (in the order of ``terms``) at arms ``rho (..., nm, 3)``: their maps
+    ``B_i (..., v, 3, 6)``, ``B_i^T k_i (..., v, 6, 3)`` and ``B_i^T k_i B_i (..., v, 6, 6)``."""
+    maps = rigid_map(rho[..., [i for i, _, _, _ in terms], :])
+    btk = np.swapaxes(maps, -1, -2) @ np.stack([km for _, km, _, _ in terms])
+    return maps, btk, btk @ maps
 
 
 def _reduced_ranks(positions: Array, terms) -> dict[float, int]:
     """Rank of the stacked maps ``B`` of each relaxation time's mounts (at most 6; the same at every
     thrust: the equilibrium only rotates the arms)."""
+    maps = _mount_maps(positions, terms)[0]
     ranks = {}
     for tj, members in _groups(terms).items():
-        b = np.concatenate([rigid_map(positions[i]) for i, _, _ in members], axis=0)
-        sv = np.linalg.svd(b, compute_uv=False)
+        sv = np.linalg.svd(maps[[j for j, _ in members]].reshape(-1, 6), compute_uv=False)
         ranks[tj] = int((sv > 1e-12 * sv[0]).sum())
     return ranks
 
@@ -95,35 +103,35 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
     (:func:`_reduced_ranks`), where known; otherwise from the first stack with finite arms.
     """
     s = m.shape[0]
-    kk = np.array(k, dtype=float, copy=True)
-    maps = {i: rigid_map(rho[:, i]) for i, _, _, _ in terms}                              # (S, 3, 6)
-    mount_k = {i: np.swapaxes(maps[i], -1, -2) @ kmount[None] for i, kmount, _, _ in terms}  # B_i^T k_i (S, 6, 3)
+    maps, btk, stiff = _mount_maps(rho, terms)          # (S, v, 3, 6), (S, v, 6, 3), (S, v, 6, 6)
+    weights = np.zeros(len(terms))
     blocks = []   # (rows from q (S, r, 6), force columns (S, 6, r), tau)
     if reduced:
         eye = np.broadcast_to(np.eye(6), (s, 6, 6))
         for tj, members in _groups(terms).items():
-            b = np.concatenate([maps[i] for i, _, _ in members], axis=1)                    # (S, 3m, 6)
-            cols = np.concatenate([gj * mount_k[i] for i, _, gj in members], axis=2)       # (S, 6, 3m)
-            k_tau = cols @ b                                                              # (S, 6, 6)
-            kk += k_tau
-            finite = np.where(np.isfinite(b), b, 0.0)
+            js = [j for j, _ in members]
+            gs = np.array([gj for _, gj in members])
+            for j, gj in members:
+                weights[j] += gj
             if ranks is not None:
                 rank = ranks[tj]
             else:  # invariant under the rotation of the arms
-                row = int(np.argmax(np.isfinite(b).all(axis=(1, 2))))
-                sv = np.linalg.svd(finite[row], compute_uv=False)
+                row = int(np.argmax(np.isfinite(maps).all(axis=(1, 2, 3))))
+                sv = np.linalg.svd(maps[row, js].reshape(-1, 6), compute_uv=False)
                 rank = int((sv > 1e-12 * sv[0]).sum())
             if rank == 6:
-                blocks.append((eye, k_tau, tj))
+                blocks.append((eye, np.einsum("v,svab->sab", gs, stiff[:, js]), tj))
                 continue
-            u = np.linalg.svd(finite)[0][:, :, :rank]
+            b = maps[:, js].reshape(s, -1, 6)                                              # (S, 3m, 6)
+            cols = np.concatenate(list(gs[:, None, None, None] * np.swapaxes(btk[:, js], 0, 1)), axis=2)  # (S, 6, 3m)
+            u = np.linalg.svd(np.where(np.isfinite(b), b, 0.0))[0][:, :, :rank]
             blocks.append((np.swapaxes(u, -1, -2) @ b, cols @ u, tj))
     else:
-        for i, kmount, g, tau in terms:
-            b, btk = maps[i], mount_k[i]
+        for j, (_, _, g, tau) in enumerate(terms):
+            weights[j] = float(np.sum(g))
             for gj, tj in zip(g, tau):
-                kk += gj * btk @ b
-                blocks.append((b, gj * btk, float(tj)))
+                blocks.append((maps[:, j], gj * btk[:, j], float(tj)))
+    kk = k + np.einsum("v,svab->sab", weights, stiff)
     nz = sum(blk[0].shape[1] for blk in blocks)
     n = 12 + nz
     e = np.zeros((s, n, n))
@@ -149,21 +157,24 @@ def dynamic_stiffness(lam: complex, m, c, k, rho, model: Model, exact: bool = Tr
 
     ``exact`` uses each mount's law; otherwise its Prony series.
     """
+    terms = _terms(model)
+    return _dynamic(lam, m, c, k, _mount_maps(np.asarray(rho, dtype=float), terms)[2], model, terms, exact)
+
+
+def _dynamic(lam: complex, m, c, k, stiff: Array, model: Model, terms, exact: bool = True) -> Array:
+    """:func:`dynamic_stiffness` with the mounts' ``B_i^T k_i B_i`` given (``stiff (v, 6, 6)``)."""
     f = lam * lam * m + lam * c + k + 0j
-    for i, kmount, g, tau in _terms(model):
-        law = model.mounts[i].viscoelastic
-        b = rigid_map(rho[i])
-        r = law.ratio_at(lam) if exact else prony_ratio(lam, g, tau)
-        f = f + b.T @ kmount @ b * (complex(r) - 1.0)
+    for j, (i, _, g, tau) in enumerate(terms):
+        r = model.mounts[i].viscoelastic.ratio_at(lam) if exact else prony_ratio(lam, g, tau)
+        f = f + stiff[j] * (complex(r) - 1.0)
     return f
 
 
-def _d_dynamic_stiffness(lam: complex, m, c, rho, model: Model) -> Array:
-    """``dF / d lambda`` with the exact laws."""
+def _d_dynamic_stiffness(lam: complex, m, c, stiff: Array, model: Model, terms) -> Array:
+    """``dF / d lambda`` with the exact laws (``stiff`` as :func:`_dynamic`)."""
     f = 2.0 * lam * m + c + 0j
-    for i, kmount, _, _ in _terms(model):
-        b = rigid_map(rho[i])
-        f = f + b.T @ kmount @ b * model.mounts[i].viscoelastic.dratio_at(lam)
+    for j, (i, _, _, _) in enumerate(terms):
+        f = f + stiff[j] * model.mounts[i].viscoelastic.dratio_at(lam)
     return f
 
 
@@ -303,14 +314,32 @@ def exact_onset(model: Model, thrust: float, omega: float, linearization: str | 
     static stiffness: ``T`` alone), the equation the eigenvalue ``mu(i omega, T)`` of ``F`` nearest
     zero (the mean of a cluster of equal ones, so that the identical planes of a symmetric layout
     keep the convergence quadratic), with its exact derivative ``y^H dF x / y^H x``;
-    ``dF/d omega = i dF/d lambda`` exactly, ``dF/dT`` by central differences of the linearization.
+    ``dF/d omega = i dF/d lambda`` exactly, ``dF/dT`` exactly ``K1`` where the family is affine in
+    the thrust (else by central differences of the linearization).
     ``family``: the model's :class:`ViscoelasticFamily` when one exists already (same settings).
     """
     fam = family if family is not None else ViscoelasticFamily(model, linearization, fluid_frequency)
+    terms = fam.terms  # type: ignore[attr-defined]
+    parts = fam.base.affine_parts()  # type: ignore[attr-defined]
+    if parts is not None:  # K = K0 + T K1 with constant M, D + G and arms: dF/dT = K1 exactly
+        m0, d0, g0, k0, k1 = parts
+        c0 = d0 + g0
+        stiff0 = _mount_maps(fam.positions, terms)[2]  # type: ignore[attr-defined]
 
-    def dyn(t: float, lam: complex):
-        m, c, k, rho = fam.system(np.array([t]))
-        return dynamic_stiffness(lam, m[0], c[0], k[0], rho[0], model), (m[0], c[0], rho[0])
+        def dyn(t: float, lam: complex):
+            return _dynamic(lam, m0, c0, k0 + t * k1, stiff0, model, terms), (m0, c0, stiff0)
+
+        def dyn_t(t: float, lam: complex):
+            return k1 + 0j
+    else:
+        def dyn(t: float, lam: complex):
+            m, c, k, rho = fam.system(np.array([t]))
+            stiff = _mount_maps(rho[0], terms)[2]
+            return _dynamic(lam, m[0], c[0], k[0], stiff, model, terms), (m[0], c[0], stiff)
+
+        def dyn_t(t: float, lam: complex):
+            h = 1e-6 * max(abs(t), 1.0)
+            return (dyn(t + h, lam)[0] - dyn(t - h, lam)[0]) / (2 * h)
 
     t, w = float(thrust), float(abs(omega))
     flutter = w > 0.0
@@ -319,16 +348,15 @@ def exact_onset(model: Model, thrust: float, omega: float, linearization: str | 
     dt = dw = np.inf
     for it in range(1, NEWTON_MAX + 1):
         lam = 1j * w
-        f, (m, c, rho) = dyn(t, lam)
+        f, (m, c, stiff) = dyn(t, lam)
         if not np.isfinite(f).all():
             break
-        h = 1e-6 * max(abs(t), 1.0)
-        f_t = (dyn(t + h, lam)[0] - dyn(t - h, lam)[0]) / (2 * h)
+        f_t = dyn_t(t, lam)
         try:
             x, y, mu = _cluster(f)
             b = _mean_derivative(x, y, f_t)
             if flutter:
-                a = 1j * _mean_derivative(x, y, _d_dynamic_stiffness(lam, m, c, rho, model))
+                a = 1j * _mean_derivative(x, y, _d_dynamic_stiffness(lam, m, c, stiff, model, terms))
                 dw, dt = np.linalg.solve(np.array([[a.real, b.real], [a.imag, b.imag]]), [-mu.real, -mu.imag])
             else:
                 dw, dt = 0.0, -mu.real / b.real
