@@ -72,19 +72,22 @@ def _mount_maps(rho: Array, terms) -> tuple[Array, Array, Array]:
     return maps, btk, btk @ maps
 
 
-def _reduced_ranks(positions: Array, terms) -> dict[float, int]:
+def _reduced_ranks(maps: Array, terms) -> dict[float, int]:
     """Rank of the stacked maps ``B`` of each relaxation time's mounts (at most 6; the same at every
-    thrust: the equilibrium only rotates the arms)."""
-    maps = _mount_maps(positions, terms)[0]
-    ranks = {}
+    thrust: the equilibrium only rotates the arms), from the maps ``(v, 3, 6)`` of :func:`_mount_maps`."""
+    ranks: dict[float, int] = {}
+    by_mounts: dict[tuple, int] = {}  # relaxation times of the same mounts share the rank
     for tj, members in _groups(terms).items():
-        sv = np.linalg.svd(maps[[j for j, _ in members]].reshape(-1, 6), compute_uv=False)
-        ranks[tj] = int((sv > 1e-12 * sv[0]).sum())
+        js = tuple(j for j, _ in members)
+        if js not in by_mounts:
+            sv = np.linalg.svd(maps[list(js)].reshape(-1, 6), compute_uv=False)
+            by_mounts[js] = int((sv > 1e-12 * sv[0]).sum())
+        ranks[tj] = by_mounts[js]
     return ranks
 
 
 def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced: bool = False,
-                       ranks: dict[float, int] | None = None) -> tuple[Array, Array]:
+                       ranks: dict[float, int] | None = None, maps=None) -> tuple[Array, Array]:
     """``E, A`` of the augmented state for stacks ``m, c = D + G, k (S, 6, 6)`` and arms ``rho (S, nm, 3)``.
 
     ``terms`` as :func:`_terms` returns. Returns ``E, A (S, N, N)``, ``N = 12 + 3 sum n_i``.
@@ -101,9 +104,10 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
     each with its own internal states). Below rank 6 they are ``w = U^T z`` (``U`` an orthonormal
     basis of range B, from an SVD). ``ranks``: those ranks by relaxation time
     (:func:`_reduced_ranks`), where known; otherwise from the first stack with finite arms.
+    ``maps``: :func:`_mount_maps` of ``rho`` where already known.
     """
     s = m.shape[0]
-    maps, btk, stiff = _mount_maps(rho, terms)          # (S, v, 3, 6), (S, v, 6, 3), (S, v, 6, 6)
+    maps, btk, stiff = _mount_maps(rho, terms) if maps is None else maps  # (S, v, 3, 6), (S, v, 6, 3), (S, v, 6, 6)
     weights = np.zeros(len(terms))
     blocks = []   # (rows from q (S, r, 6), force columns (S, 6, r), tau)
     if reduced:
@@ -209,6 +213,15 @@ class ViscoelasticFamily:
         object.__setattr__(self, "positions", np.array([mt.position for mt in self.model.mounts], dtype=float))
 
     @property
+    def rest_maps(self) -> tuple[Array, Array, Array]:
+        """:func:`_mount_maps` at the mounts' positions (the arms of an affine family at every thrust)."""
+        hit = self.__dict__.get("_rest_maps")
+        if hit is None:
+            hit = _mount_maps(self.positions, self.terms)  # type: ignore[attr-defined]
+            object.__setattr__(self, "_rest_maps", hit)
+        return hit
+
+    @property
     def ranks(self) -> dict[float, int] | None:
         """Reduced families: the internal states kept per relaxation time (the rank of its mounts'
         stacked maps; the same at every thrust, the equilibrium only rotates the arms)."""
@@ -216,7 +229,7 @@ class ViscoelasticFamily:
             return None
         hit = self.__dict__.get("_ranks")
         if hit is None:
-            hit = _reduced_ranks(self.positions, self.terms)  # type: ignore[attr-defined]
+            hit = _reduced_ranks(self.rest_maps[0], self.terms)  # type: ignore[attr-defined]
             object.__setattr__(self, "_ranks", hit)
         return hit
 
@@ -255,7 +268,7 @@ class ViscoelasticFamily:
         m, d, g, k0, k1 = parts
         rho = self.positions[None]  # type: ignore[attr-defined]
         e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms, self.reduced,  # type: ignore[attr-defined]
-                                   self.ranks)
+                                   self.ranks, tuple(x[None] for x in self.rest_maps))
         a1 = np.zeros_like(a0[0])
         a1[6:12, :6] = -k1
         return e[0], a0[0], a1
@@ -324,7 +337,7 @@ def exact_onset(model: Model, thrust: float, omega: float, linearization: str | 
     if parts is not None:  # K = K0 + T K1 with constant M, D + G and arms: dF/dT = K1 exactly
         m0, d0, g0, k0, k1 = parts
         c0 = d0 + g0
-        stiff0 = _mount_maps(fam.positions, terms)[2]  # type: ignore[attr-defined]
+        stiff0 = fam.rest_maps[2]
 
         def dyn(t: float, lam: complex):
             return _dynamic(lam, m0, c0, k0 + t * k1, stiff0, model, terms), (m0, c0, stiff0)
