@@ -38,7 +38,11 @@ References and baselines, each on the same matrices and timed in the same run:
   relative. ``"viscoelastic_speedup"`` is its time over ``impstab.critical_thrust(model)`` end to
   end (which also finds the undamped companion and checks the onset on the exact law by Newton);
   ``"viscoelastic_speedup_engine"`` over the engine alone on the matrices critical_thrust hands it
-  (the internal variables no motion reaches dropped: 24 states).
+  (the internal variables no motion reaches dropped: 24 states, in the body's dof coordinates, so
+  that the engine sees the planes' blocks of 4, 8, 8 and 4 states).
+
+``--only PART`` (repeatable: ``examples``, ``beam``, ``beck``, ``viscoelastic``) runs only those
+parts; the JSON line then has their keys only.
 
 Timings are the best of interleaved rounds of CPU time (the timeit convention: the other
 rounds were slowed by something else; on a shared machine wall time varies by 2x from second

@@ -334,3 +334,32 @@ def test_undamped_companion_is_the_model_without_dampers_and_with_static_stiffne
     assert not model.undamped().is_damped
     assert res.undamped_thrust == pytest.approx(plain.thrust, rel=1e-12)
     assert res.undamped_kind == plain.kind
+
+
+def test_onset_of_identical_planes_by_newton_equals_a_plain_dense_scan():
+    """Three mounts with two Prony terms each: the flutter pair appears twice (the sway-yaw and the
+    heave-pitch plane), a cluster of copies that the engine refines by Newton on their mean growth.
+    The onset equals a plain scan of the full 30-state matrix (numpy eigvals on the same grid, then
+    bisection on max Re lambda > 0 to 1e-14 relative), the rightmost pair is doubled there, and the
+    refinement takes a handful of eigen-decompositions (not a bisection tail at the rounding
+    floor): 35 scan points up to the bracket, at most 6 more."""
+    from impstab.linear.critical import critical_load_family
+
+    model = _model({"law": "prony", "terms": [[0.3, 1e-3], [0.5, 2e-2]]}, linearization="classical")
+    res = critical_load_family(ViscoelasticFamily(model, reduced=True), 30000.0)
+    e, a0, a1 = ViscoelasticFamily(model).affine_parts()
+    a0, a1 = np.linalg.solve(e, a0), np.linalg.solve(e, a1)
+    growth = lambda t: np.linalg.eigvals(a0 + t * a1).real.max()  # noqa: E731
+    grid = np.linspace(0.0, 30000.0, 65)
+    i = next(i for i, t in enumerate(grid) if growth(t) > 0)
+    lo, hi = grid[i - 1], grid[i]
+    while hi - lo > 1e-14 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if growth(mid) > 0 else (mid, hi)
+    assert res.kind == "flutter"
+    assert res.load == pytest.approx(hi, rel=1e-11)
+    lam = np.linalg.eigvals(a0 + res.load * a1)
+    top = lam[np.argsort(-lam.real)[:4]]
+    assert np.abs(top.real).max() <= 1e-9 * np.abs(top).max()
+    assert np.sort(np.abs(top.imag)) == pytest.approx([res.omega] * 4, rel=1e-8)
+    assert res.evaluations <= 35 + 6

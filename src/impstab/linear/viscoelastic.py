@@ -15,7 +15,10 @@ mount's static 3 x 3 translation stiffness:
     det(lambda^2 M + lambda (D + G) + K + sum_i B_i^T k_i B_i (r_i(lambda) - 1)) = 0
 
 with the mount's ratio ``r_i = k*/k0`` (:mod:`impstab.model.viscoelastic`). The engine
-(:mod:`impstab.linear.engine`) solves the augmented family; :func:`exact_onset` then solves the
+(:mod:`impstab.linear.engine`) solves the augmented family (for the critical thrust the reduced
+one, :func:`augmented_matrices`: the internal states the motion reaches, in the body's dof
+coordinates where the mounts' maps have full rank, so a symmetric layout keeps its decoupled
+planes and each eigenproblem of the scan is a few small blocks); :func:`exact_onset` then solves the
 nonlinear eigenproblem with the law itself (not its Prony fit) at the onset by Newton on
 ``(T, omega)`` with ``lambda = i omega``, which checks (and for a fitted law, corrects) it.
 """
