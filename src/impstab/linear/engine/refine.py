@@ -42,15 +42,12 @@ from .layout import (AFFINE, BISECTIONS, BRACKETS, DECOMPOSITIONS, DIRECTION, EV
                      OMEGA, START_UNSTABLE, STATUS, WARNED)
 from .scan import _classify
 from .spectra import FAILED, NOT_FINITE, OK, PROVIDER_ERROR, cache_new, provided_weights, spectrum, workspace
-from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
+from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_COPIES, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
 
 __all__ = ["refine_stack"]
 
 #: onset kinds; a limit point still to be located by the caller (its bracket is returned)
 FLUTTER, DIVERGENCE, LIMIT = 1, 2, 3
-#: a first-order cluster of more than one pair whose upper-half members agree to this (relative)
-#: is copies of one pair (identical planes): its growth is refined by Newton on their mean
-TOL_COPIES = 1e-9
 _EPS4 = 4.0 * EPS
 
 
