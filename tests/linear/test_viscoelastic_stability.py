@@ -265,3 +265,101 @@ def test_reduced_family_drops_only_the_unreached_relaxation_roots():
 
     t_full = critical_load_family(full, 30000.0).load
     assert impstab.critical_thrust(model).thrust == pytest.approx(t_full, rel=1e-10)
+
+
+def test_reduced_states_in_dof_coordinates_are_the_exact_roots_and_keep_the_planes_apart():
+    """Three standard-linear-solid mounts (B of rank 6): the reduced family keeps one internal
+    6-vector in the body's dof coordinates, 18 states whose eigenvalues are the 18 roots of the exact
+    characteristic polynomial (companion pencil, _poly_roots), at a thrust with flutter and one
+    without; and its operator splits into the blocks of the symmetric layout (surge and roll with
+    their internal states, 3 each; the sway-yaw and heave-pitch planes, 6 each)."""
+    from impstab.linear.blocks import decoupled_blocks
+
+    model = _model(linearization="classical")
+    g, tau = 0.5, 2e-3
+    fam = ViscoelasticFamily(model, reduced=True)
+    assert fam.n == 18
+    for thrust in (4000.0, 29000.0):
+        lin = impstab.linearize(model, thrust, "classical")
+        roots = list(_poly_roots(lin, model.elastic_stiffness, g, tau))
+        e, a = fam.matrices(np.array([thrust]))
+        for lam in np.linalg.eigvals(np.linalg.solve(e[0], a[0])):
+            j = int(np.argmin(np.abs(np.array(roots) - lam)))
+            assert abs(roots[j] - lam) <= 1e-8 * max(abs(lam), 1.0), (lam, roots[j])
+            roots.pop(j)
+        assert not roots
+    e, a0, a1 = fam.affine_parts()
+    blocks = decoupled_blocks(np.linalg.solve(e, a0)[None], np.linalg.solve(e, a1)[None], np.array([30000.0]))
+    sizes = np.diff(blocks.starts[0, : blocks.nblocks[0] + 1])
+    assert sorted(sizes.tolist()) == [3, 3, 6, 6]
+
+
+def test_reduced_states_below_full_rank_drop_only_the_unreached_root():
+    """Two viscoelastic mounts of the asymmetric layout: their stacked maps have rank 5 (a rotation
+    about the line through them moves neither), so of the 6 internal states one combination is never
+    reached: the reduced family (an orthonormal basis of range B) has 17 states, every eigenvalue
+    of the full 18-state system but one, and that one is -1/tau."""
+    from conftest import asymmetric_model_dict
+
+    d = asymmetric_model_dict()
+    tau = 3e-3
+    for m in d["mounts"][:2]:
+        m["viscoelastic"] = {"law": "standard-linear-solid", "stiffening": 1.6, "relaxation_time": tau}
+    d["analysis"]["linearization"] = "classical"
+    model = model_from_dict(d)
+    full, small = ViscoelasticFamily(model), ViscoelasticFamily(model, reduced=True)
+    assert (full.n, small.n) == (18, 17)
+    e, a = full.matrices(np.array([3000.0]))
+    er, ar = small.matrices(np.array([3000.0]))
+    lam = list(np.linalg.eigvals(np.linalg.solve(e[0], a[0])))
+    for r in np.linalg.eigvals(np.linalg.solve(er[0], ar[0])):
+        j = int(np.argmin(np.abs(np.array(lam) - r)))
+        assert abs(lam[j] - r) <= 1e-8 * max(abs(r), 1.0)
+        lam.pop(j)
+    assert len(lam) == 1 and lam[0] == pytest.approx(-1 / tau, rel=1e-8)
+
+
+@pytest.mark.parametrize("dampers", [False, True])
+def test_undamped_companion_is_the_model_without_dampers_and_with_static_stiffness(dampers):
+    """The undamped critical thrust of a viscoelastic model, with or without viscous dampers beside
+    the laws, is that of model.undamped() (dampers removed, the mounts elastic at their static
+    stiffness), solved as an elastic model of its own."""
+    d = ring_model_dict()
+    d["mount_rings"][0]["viscoelastic"] = dict(SLS)
+    if dampers:
+        d["mount_rings"][0].update(c_axial=60.0, c_shear=15.0)
+    model = model_from_dict(d)
+    res = impstab.critical_thrust(model)
+    plain = impstab.critical_thrust(model.undamped())
+    assert not model.undamped().is_damped
+    assert res.undamped_thrust == pytest.approx(plain.thrust, rel=1e-12)
+    assert res.undamped_kind == plain.kind
+
+
+def test_onset_of_identical_planes_by_newton_equals_a_plain_dense_scan():
+    """Three mounts with two Prony terms each: the flutter pair appears twice (the sway-yaw and the
+    heave-pitch plane), a cluster of copies that the engine refines by Newton on their mean growth.
+    The onset equals a plain scan of the full 30-state matrix (numpy eigvals on the same grid, then
+    bisection on max Re lambda > 0 to 1e-14 relative), the rightmost pair is doubled there, and the
+    refinement takes a handful of eigen-decompositions (not a bisection tail at the rounding
+    floor): 35 scan points up to the bracket, at most 6 more."""
+    from impstab.linear.critical import critical_load_family
+
+    model = _model({"law": "prony", "terms": [[0.3, 1e-3], [0.5, 2e-2]]}, linearization="classical")
+    res = critical_load_family(ViscoelasticFamily(model, reduced=True), 30000.0)
+    e, a0, a1 = ViscoelasticFamily(model).affine_parts()
+    a0, a1 = np.linalg.solve(e, a0), np.linalg.solve(e, a1)
+    growth = lambda t: np.linalg.eigvals(a0 + t * a1).real.max()  # noqa: E731
+    grid = np.linspace(0.0, 30000.0, 65)
+    i = next(i for i, t in enumerate(grid) if growth(t) > 0)
+    lo, hi = grid[i - 1], grid[i]
+    while hi - lo > 1e-14 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if growth(mid) > 0 else (mid, hi)
+    assert res.kind == "flutter"
+    assert res.load == pytest.approx(hi, rel=1e-11)
+    lam = np.linalg.eigvals(a0 + res.load * a1)
+    top = lam[np.argsort(-lam.real)[:4]]
+    assert np.abs(top.real).max() <= 1e-9 * np.abs(top).max()
+    assert np.sort(np.abs(top.imag)) == pytest.approx([res.omega] * 4, rel=1e-8)
+    assert res.evaluations <= 35 + 6

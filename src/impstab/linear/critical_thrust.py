@@ -252,9 +252,7 @@ def critical_thrust(
             if change is not None and change <= FLUID_TOLERANCE:
                 break
     if model.is_damped or (model.fluid.compressible and f_fluid > 0):
-        und = critical_load_family(
-            ModelFamily(model, linearization, damped=False, fluid_frequency=f_fluid), t_max, **search
-        )
+        und = critical_load_family(_undamped_family(model, linearization, f_fluid, fam), t_max, **search)
     else:
         und = res
     load, omega, check, fits, visco_notes = res.load, res.omega, None, (), ()
@@ -307,6 +305,15 @@ def _family(model: Model, linearization: str | None, fluid_frequency: float = 0.
 
         return ViscoelasticFamily(model, linearization, fluid_frequency, reduced=True)
     return ModelFamily(model, linearization, fluid_frequency=fluid_frequency)
+
+
+def _undamped_family(model: Model, linearization: str | None, f_fluid: float, family) -> ModelFamily:
+    """The undamped companion's family: the viscoelastic family's elastic part (mounts at their
+    static stiffness) where the model has no damper besides its viscoelastic laws, else built."""
+    base = getattr(family, "base", None)
+    if isinstance(base, ModelFamily) and not (base.packed.damp6.any() or base.packed.damping.any()):
+        return base
+    return ModelFamily(model, linearization, damped=False, fluid_frequency=f_fluid)
 
 
 def _viscoelastic_check(model: Model, res: CriticalLoad, linearization: str, f_fluid: float, family=None):

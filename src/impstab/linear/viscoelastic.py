@@ -15,7 +15,10 @@ mount's static 3 x 3 translation stiffness:
     det(lambda^2 M + lambda (D + G) + K + sum_i B_i^T k_i B_i (r_i(lambda) - 1)) = 0
 
 with the mount's ratio ``r_i = k*/k0`` (:mod:`impstab.model.viscoelastic`). The engine
-(:mod:`impstab.linear.engine`) solves the augmented family; :func:`exact_onset` then solves the
+(:mod:`impstab.linear.engine`) solves the augmented family (for the critical thrust the reduced
+one, :func:`augmented_matrices`: the internal states the motion reaches, in the body's dof
+coordinates where the mounts' maps have full rank, so a symmetric layout keeps its decoupled
+planes and each eigenproblem of the scan is a few small blocks); :func:`exact_onset` then solves the
 nonlinear eigenproblem with the law itself (not its Prony fit) at the onset by Newton on
 ``(T, omega)`` with ``lambda = i omega``, which checks (and for a fitted law, corrects) it.
 """
@@ -55,7 +58,39 @@ def _terms(model: Model):
     return out
 
 
-def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced: bool = False) -> tuple[Array, Array]:
+def _groups(terms) -> dict[float, list]:
+    """``{tau: [(position in terms, g), ...]}``: the Prony terms that share a relaxation time."""
+    groups: dict[float, list] = {}
+    for j, (_, _, g, tau) in enumerate(terms):
+        for gj, tj in zip(g, tau):
+            groups.setdefault(float(tj), []).append((j, float(gj)))
+    return groups
+
+
+def _mount_maps(rho: Array, terms) -> tuple[Array, Array, Array]:
+    """For the viscoelastic mounts (in the order of ``terms``) at arms ``rho (..., nm, 3)``: their maps
+    ``B_i (..., v, 3, 6)``, ``B_i^T k_i (..., v, 6, 3)`` and ``B_i^T k_i B_i (..., v, 6, 6)``."""
+    maps = rigid_map(rho[..., [i for i, _, _, _ in terms], :])
+    btk = np.swapaxes(maps, -1, -2) @ np.stack([km for _, km, _, _ in terms])
+    return maps, btk, btk @ maps
+
+
+def _reduced_ranks(maps: Array, terms) -> dict[float, int]:
+    """Rank of the stacked maps ``B`` of each relaxation time's mounts (at most 6; the same at every
+    thrust: the equilibrium only rotates the arms), from the maps ``(v, 3, 6)`` of :func:`_mount_maps`."""
+    ranks: dict[float, int] = {}
+    by_mounts: dict[tuple, int] = {}  # relaxation times of the same mounts share the rank
+    for tj, members in _groups(terms).items():
+        js = tuple(j for j, _ in members)
+        if js not in by_mounts:
+            sv = np.linalg.svd(maps[list(js)].reshape(-1, 6), compute_uv=False)
+            by_mounts[js] = int((sv > 1e-12 * sv[0]).sum())
+        ranks[tj] = by_mounts[js]
+    return ranks
+
+
+def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced: bool = False,
+                       ranks: dict[float, int] | None = None, maps=None) -> tuple[Array, Array]:
     """``E, A`` of the augmented state for stacks ``m, c = D + G, k (S, 6, 6)`` and arms ``rho (S, nm, 3)``.
 
     ``terms`` as :func:`_terms` returns. Returns ``E, A (S, N, N)``, ``N = 12 + 3 sum n_i``.
@@ -63,36 +98,47 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
     ``reduced``: the internal variables that share a relaxation time ``tau`` obey one equation
     ``tau z' = B q - z`` (``B`` the mounts' maps stacked): only ``z`` in the range of ``B`` (rank
     at most 6) is reached from the motion, the rest decays at ``-1/tau`` whatever the body does
-    (block-triangular form). Those are dropped: the states ``w = U^T z`` (``U`` an orthonormal
-    basis of range B, from an SVD) keep every other eigenvalue exactly, and the stability; the
-    dropped roots ``-1/tau`` are stable.
+    (block-triangular form). Those are dropped, every other eigenvalue is kept exactly, and the
+    stability; the dropped roots ``-1/tau`` are stable. Where ``B`` has full rank 6 (three mounts
+    or more, not on one line) the states kept are ``z = B zeta`` in the body's own dof coordinates:
+    ``tau zeta' = q - zeta``, with the force ``K_tau zeta``, ``K_tau = sum g B_i^T k_i B_i``. They
+    couple only the dofs the mounts' stiffness couples, so the operator keeps the decoupled blocks
+    of a symmetric layout (:mod:`impstab.linear.blocks`: the sway-yaw and heave-pitch planes apart,
+    each with its own internal states). Below rank 6 they are ``w = U^T z`` (``U`` an orthonormal
+    basis of range B, from an SVD). ``ranks``: those ranks by relaxation time
+    (:func:`_reduced_ranks`), where known; otherwise from the first stack with finite arms.
+    ``maps``: :func:`_mount_maps` of ``rho`` where already known.
     """
     s = m.shape[0]
-    kk = np.array(k, dtype=float, copy=True)
+    maps, btk, stiff = _mount_maps(rho, terms) if maps is None else maps  # (S, v, 3, 6), (S, v, 6, 3), (S, v, 6, 6)
+    weights = np.zeros(len(terms))
     blocks = []   # (rows from q (S, r, 6), force columns (S, 6, r), tau)
     if reduced:
-        groups: dict[float, list] = {}
-        for i, kmount, g, tau in terms:
-            for gj, tj in zip(g, tau):
-                groups.setdefault(float(tj), []).append((i, kmount, gj))
-        for tj, members in groups.items():
-            b = np.concatenate([rigid_map(rho[:, i]) for i, _, _ in members], axis=1)          # (S, 3m, 6)
-            cols = np.concatenate([gj * np.swapaxes(rigid_map(rho[:, i]), -1, -2) @ kmount[None]
-                                   for i, kmount, gj in members], axis=2)                     # (S, 6, 3m)
-            for i, kmount, gj in members:
-                bi = rigid_map(rho[:, i])
-                kk += gj * np.swapaxes(bi, -1, -2) @ kmount[None] @ bi
-            u, sv, _ = np.linalg.svd(np.where(np.isfinite(b), b, 0.0))
-            rank = int((sv[0] > 1e-12 * sv[0, :1]).sum())  # invariant under the rotation of the arms
-            u = u[:, :, :rank]
+        eye = np.broadcast_to(np.eye(6), (s, 6, 6))
+        for tj, members in _groups(terms).items():
+            js = [j for j, _ in members]
+            gs = np.array([gj for _, gj in members])
+            for j, gj in members:
+                weights[j] += gj
+            if ranks is not None:
+                rank = ranks[tj]
+            else:  # invariant under the rotation of the arms
+                row = int(np.argmax(np.isfinite(maps).all(axis=(1, 2, 3))))
+                sv = np.linalg.svd(maps[row, js].reshape(-1, 6), compute_uv=False)
+                rank = int((sv > 1e-12 * sv[0]).sum())
+            if rank == 6:
+                blocks.append((eye, np.einsum("v,svab->sab", gs, stiff[:, js]), tj))
+                continue
+            b = maps[:, js].reshape(s, -1, 6)                                              # (S, 3m, 6)
+            cols = np.concatenate(list(gs[:, None, None, None] * np.swapaxes(btk[:, js], 0, 1)), axis=2)  # (S, 6, 3m)
+            u = np.linalg.svd(np.where(np.isfinite(b), b, 0.0))[0][:, :, :rank]
             blocks.append((np.swapaxes(u, -1, -2) @ b, cols @ u, tj))
     else:
-        for i, kmount, g, tau in terms:
-            b = rigid_map(rho[:, i])                       # (S, 3, 6)
-            btk = np.swapaxes(b, -1, -2) @ kmount[None]    # (S, 6, 3)
+        for j, (_, _, g, tau) in enumerate(terms):
+            weights[j] = float(np.sum(g))
             for gj, tj in zip(g, tau):
-                kk += gj * btk @ b
-                blocks.append((b, gj * btk, float(tj)))
+                blocks.append((maps[:, j], gj * btk[:, j], float(tj)))
+    kk = k + np.einsum("v,svab->sab", weights, stiff)
     nz = sum(blk[0].shape[1] for blk in blocks)
     n = 12 + nz
     e = np.zeros((s, n, n))
@@ -118,21 +164,24 @@ def dynamic_stiffness(lam: complex, m, c, k, rho, model: Model, exact: bool = Tr
 
     ``exact`` uses each mount's law; otherwise its Prony series.
     """
+    terms = _terms(model)
+    return _dynamic(lam, m, c, k, _mount_maps(np.asarray(rho, dtype=float), terms)[2], model, terms, exact)
+
+
+def _dynamic(lam: complex, m, c, k, stiff: Array, model: Model, terms, exact: bool = True) -> Array:
+    """:func:`dynamic_stiffness` with the mounts' ``B_i^T k_i B_i`` given (``stiff (v, 6, 6)``)."""
     f = lam * lam * m + lam * c + k + 0j
-    for i, kmount, g, tau in _terms(model):
-        law = model.mounts[i].viscoelastic
-        b = rigid_map(rho[i])
-        r = law.ratio_at(lam) if exact else prony_ratio(lam, g, tau)
-        f = f + b.T @ kmount @ b * (complex(r) - 1.0)
+    for j, (i, _, g, tau) in enumerate(terms):
+        r = model.mounts[i].viscoelastic.ratio_at(lam) if exact else prony_ratio(lam, g, tau)
+        f = f + stiff[j] * (complex(r) - 1.0)
     return f
 
 
-def _d_dynamic_stiffness(lam: complex, m, c, rho, model: Model) -> Array:
-    """``dF / d lambda`` with the exact laws."""
+def _d_dynamic_stiffness(lam: complex, m, c, stiff: Array, model: Model, terms) -> Array:
+    """``dF / d lambda`` with the exact laws (``stiff`` as :func:`_dynamic`)."""
     f = 2.0 * lam * m + c + 0j
-    for i, kmount, _, _ in _terms(model):
-        b = rigid_map(rho[i])
-        f = f + b.T @ kmount @ b * model.mounts[i].viscoelastic.dratio_at(lam)
+    for j, (i, _, _, _) in enumerate(terms):
+        f = f + stiff[j] * model.mounts[i].viscoelastic.dratio_at(lam)
     return f
 
 
@@ -167,17 +216,31 @@ class ViscoelasticFamily:
         object.__setattr__(self, "positions", np.array([mt.position for mt in self.model.mounts], dtype=float))
 
     @property
-    def n(self) -> int:
-        hit = self.__dict__.get("_n")
+    def rest_maps(self) -> tuple[Array, Array, Array]:
+        """:func:`_mount_maps` at the mounts' positions (the arms of an affine family at every thrust)."""
+        hit = self.__dict__.get("_rest_maps")
         if hit is None:
-            if self.reduced:  # the ranks do not change with the thrust (a rotation of the arms)
-                rho = self.positions[None]  # type: ignore[attr-defined]
-                eye = np.eye(6)[None]
-                hit = int(augmented_matrices(eye, eye, eye, rho, self.terms, True)[1].shape[-1])  # type: ignore[attr-defined]
-            else:
-                hit = 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
-            object.__setattr__(self, "_n", hit)
+            hit = _mount_maps(self.positions, self.terms)  # type: ignore[attr-defined]
+            object.__setattr__(self, "_rest_maps", hit)
         return hit
+
+    @property
+    def ranks(self) -> dict[float, int] | None:
+        """Reduced families: the internal states kept per relaxation time (the rank of its mounts'
+        stacked maps; the same at every thrust, the equilibrium only rotates the arms)."""
+        if not self.reduced:
+            return None
+        hit = self.__dict__.get("_ranks")
+        if hit is None:
+            hit = _reduced_ranks(self.rest_maps[0], self.terms)  # type: ignore[attr-defined]
+            object.__setattr__(self, "_ranks", hit)
+        return hit
+
+    @property
+    def n(self) -> int:
+        if self.reduced:
+            return 12 + sum(self.ranks.values())  # type: ignore[union-attr]
+        return 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
 
     @property
     def weights(self) -> Array:
@@ -198,7 +261,7 @@ class ViscoelasticFamily:
 
     def matrices(self, p: Array) -> tuple[Array, Array]:
         m, c, k, rho = self.system(p)
-        return augmented_matrices(m, c, k, rho, self.terms, self.reduced)  # type: ignore[attr-defined]
+        return augmented_matrices(m, c, k, rho, self.terms, self.reduced, self.ranks)  # type: ignore[attr-defined]
 
     def affine_parts(self):
         """``(E, A0, A1)`` when the elastic family is exactly affine with constant G, else None."""
@@ -207,7 +270,8 @@ class ViscoelasticFamily:
             return None
         m, d, g, k0, k1 = parts
         rho = self.positions[None]  # type: ignore[attr-defined]
-        e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms, self.reduced)  # type: ignore[attr-defined]
+        e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms, self.reduced,  # type: ignore[attr-defined]
+                                   self.ranks, tuple(x[None] for x in self.rest_maps))
         a1 = np.zeros_like(a0[0])
         a1[6:12, :6] = -k1
         return e[0], a0[0], a1
@@ -266,14 +330,32 @@ def exact_onset(model: Model, thrust: float, omega: float, linearization: str | 
     static stiffness: ``T`` alone), the equation the eigenvalue ``mu(i omega, T)`` of ``F`` nearest
     zero (the mean of a cluster of equal ones, so that the identical planes of a symmetric layout
     keep the convergence quadratic), with its exact derivative ``y^H dF x / y^H x``;
-    ``dF/d omega = i dF/d lambda`` exactly, ``dF/dT`` by central differences of the linearization.
+    ``dF/d omega = i dF/d lambda`` exactly, ``dF/dT`` exactly ``K1`` where the family is affine in
+    the thrust (else by central differences of the linearization).
     ``family``: the model's :class:`ViscoelasticFamily` when one exists already (same settings).
     """
     fam = family if family is not None else ViscoelasticFamily(model, linearization, fluid_frequency)
+    terms = fam.terms  # type: ignore[attr-defined]
+    parts = fam.base.affine_parts()  # type: ignore[attr-defined]
+    if parts is not None:  # K = K0 + T K1 with constant M, D + G and arms: dF/dT = K1 exactly
+        m0, d0, g0, k0, k1 = parts
+        c0 = d0 + g0
+        stiff0 = fam.rest_maps[2]
 
-    def dyn(t: float, lam: complex):
-        m, c, k, rho = fam.system(np.array([t]))
-        return dynamic_stiffness(lam, m[0], c[0], k[0], rho[0], model), (m[0], c[0], rho[0])
+        def dyn(t: float, lam: complex):
+            return _dynamic(lam, m0, c0, k0 + t * k1, stiff0, model, terms), (m0, c0, stiff0)
+
+        def dyn_t(t: float, lam: complex):
+            return k1 + 0j
+    else:
+        def dyn(t: float, lam: complex):
+            m, c, k, rho = fam.system(np.array([t]))
+            stiff = _mount_maps(rho[0], terms)[2]
+            return _dynamic(lam, m[0], c[0], k[0], stiff, model, terms), (m[0], c[0], stiff)
+
+        def dyn_t(t: float, lam: complex):
+            h = 1e-6 * max(abs(t), 1.0)
+            return (dyn(t + h, lam)[0] - dyn(t - h, lam)[0]) / (2 * h)
 
     t, w = float(thrust), float(abs(omega))
     flutter = w > 0.0
@@ -282,16 +364,15 @@ def exact_onset(model: Model, thrust: float, omega: float, linearization: str | 
     dt = dw = np.inf
     for it in range(1, NEWTON_MAX + 1):
         lam = 1j * w
-        f, (m, c, rho) = dyn(t, lam)
+        f, (m, c, stiff) = dyn(t, lam)
         if not np.isfinite(f).all():
             break
-        h = 1e-6 * max(abs(t), 1.0)
-        f_t = (dyn(t + h, lam)[0] - dyn(t - h, lam)[0]) / (2 * h)
+        f_t = dyn_t(t, lam)
         try:
             x, y, mu = _cluster(f)
             b = _mean_derivative(x, y, f_t)
             if flutter:
-                a = 1j * _mean_derivative(x, y, _d_dynamic_stiffness(lam, m, c, rho, model))
+                a = 1j * _mean_derivative(x, y, _d_dynamic_stiffness(lam, m, c, stiff, model, terms))
                 dw, dt = np.linalg.solve(np.array([[a.real, b.real], [a.imag, b.imag]]), [-mu.real, -mu.imag])
             else:
                 dw, dt = 0.0, -mu.real / b.real

@@ -20,8 +20,10 @@ only bracket. The onset itself is the root of a smooth indicator that crosses ze
 
 Affine problems use the exact derivative of the indicator (eigenvalue derivatives
 ``W_C A1 V_C``) in a bracketed Newton iteration from the root of the Hermite cubic through the
-indicator and its slope at both ends; the others scipy's Brent method (``brentq``, ported as
-steps). Where the cluster at ``b`` is not clearly one at ``a``, the bracket is halved
+indicator and its slope at both ends (for a first-order cluster of more than one pair, where
+its upper half is copies of one eigenvalue, as the identical planes of a symmetric layout give:
+the trace of that half's block, the derivative of their mean); the others scipy's Brent method
+(``brentq``, ported as steps). Where the cluster at ``b`` is not clearly one at ``a``, the bracket is halved
 on the classification and tried again; where the indicator shows ``a`` already past the onset,
 ``a`` steps back by the bracket width. Where the exact route cannot be used at all, the bracket
 is narrowed on the classification alone and the result carries a warning.
@@ -40,7 +42,7 @@ from .layout import (AFFINE, BISECTIONS, BRACKETS, DECOMPOSITIONS, DIRECTION, EV
                      OMEGA, START_UNSTABLE, STATUS, WARNED)
 from .scan import _classify
 from .spectra import FAILED, NOT_FINITE, OK, PROVIDER_ERROR, cache_new, provided_weights, spectrum, workspace
-from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
+from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_COPIES, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
 
 __all__ = ["refine_stack"]
 
@@ -242,7 +244,27 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
             acc += w * row
         b[i] = acc
     if not (undamped or coalesce):
-        return f, b[jj].real, True
+        if k <= 2:
+            return f, b[jj].real, True
+        # a larger cluster: copies of one pair (identical planes of a symmetric layout) have the
+        # derivative of their mean, the trace of the upper half's block of W_C A1 V_C (invariant
+        # under the choice of basis in the repeated eigenspace); anything else: none (NaN)
+        upper = False
+        for i in range(k):
+            upper = upper or v[i].imag > 0
+        c = 0j
+        cb = 0j
+        m = 0
+        for i in range(k):
+            if not upper or v[i].imag >= 0:
+                c += v[i]
+                cb += b[i]
+                m += 1
+        c /= m
+        for i in range(k):
+            if (not upper or v[i].imag >= 0) and abs(v[i] - c) > TOL_COPIES * abs(c):
+                return f, np.nan, True
+        return f, cb.real / m, True
     if divergence:
         df = 0.0
         for i in range(k):
@@ -326,7 +348,7 @@ def newton_step(st, p, f, df):
     step = abs(new - p)
     if step <= _EPS4 * abs(p) or new == lo or new == hi:
         return new, True
-    quadratic = not np.isnan(prev) and not np.isnan(st[3]) and step <= 1e-4 * abs(prev)
+    quadratic = not np.isnan(prev) and not np.isnan(st[3]) and step <= 1e-3 * abs(prev)
     return new, quadratic and (step / (prev * prev)) * step * step <= EPS * abs(new)
 
 
@@ -554,7 +576,10 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 # is where it is off the axis by TOL_UNSTABLE
                                 target = TOL_UNSTABLE
                             coalesce = marginal and not divergence
+                        # Newton where the indicator's derivative is exact: a pair, the undamped and
+                        # the coalescence forms, and (decided at both ends) copies of one pair
                         newton = affine and target == 0.0 and (undamped or k <= 2 or coalesce)
+                        copies = affine and target == 0.0 and not newton
                         fab = np.zeros(2)
                         dfab = np.full(2, np.nan)
                         clear = True
@@ -564,7 +589,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                             if code == PROVIDER_ERROR:
                                 failed = True
                                 break
-                            slope = newton and code == OK
+                            slope = (newton or copies) and code == OK
                             f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
                                                   divergence, target, slope, sel, share, coalesce)
                             clear = clear and code != NOT_FINITE and ok
@@ -574,6 +599,8 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         if failed or not clear:
                             break
                         fa, fb = fab[0], fab[1]
+                        if copies and not (np.isnan(dfab[0]) or np.isnan(dfab[1])):
+                            newton = True
                         if fa == 0.0:
                             root = a
                         elif np.sign(fa) == np.sign(fb):

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TOL_UNSTABLE", "TOL_MARGINAL", "FLOOR", "TOL_CLUSTER", "TOL_DUPLICATE", "EPS"]
+__all__ = ["TOL_UNSTABLE", "TOL_MARGINAL", "FLOOR", "TOL_CLUSTER", "TOL_DUPLICATE", "TOL_COPIES", "EPS"]
 
 #: relative size of an imaginary part (of s) or a real part (of lambda) that counts as unstable
 TOL_UNSTABLE = 1e-7
@@ -20,5 +20,8 @@ FLOOR = 1e3 * float(np.finfo(float).eps)
 TOL_CLUSTER = 1e-6
 #: relative gap below which two real s are symmetric duplicates, not an approach
 TOL_DUPLICATE = 1e-9
+#: relative spread within which the upper half of a first-order cluster of more than one pair is
+#: copies of one eigenvalue (identical planes), refined by Newton on their mean growth
+TOL_COPIES = 1e-9
 #: machine epsilon of float64
 EPS = float(np.finfo(float).eps)
