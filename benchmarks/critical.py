@@ -51,6 +51,10 @@ to second). Also printed: eigenproblems and Python calls per solve. Ends with on
 
 from __future__ import annotations
 
+from impstab._blas import prefer_single_thread
+
+prefer_single_thread()  # before numpy loads: impstab and the baseline with one BLAS thread, as the CLI runs
+
 import json
 import math
 import sys

@@ -46,6 +46,10 @@ are noisy: compare ratios of one run.
 
 from __future__ import annotations
 
+from impstab._blas import prefer_single_thread
+
+prefer_single_thread()  # before numpy loads: impstab and the baseline with one BLAS thread, as the CLI runs
+
 import json
 import math
 import sys

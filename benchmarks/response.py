@@ -28,6 +28,10 @@ relative to their largest magnitudes. Ends with one JSON line.
 
 from __future__ import annotations
 
+from impstab._blas import prefer_single_thread
+
+prefer_single_thread()  # before numpy loads: impstab and the baseline with one BLAS thread, as the CLI runs
+
 import json
 import time
 import tomllib

@@ -37,6 +37,10 @@ motion. Prints a table of medians and ends with one JSON line.
 
 from __future__ import annotations
 
+from impstab._blas import prefer_single_thread
+
+prefer_single_thread()  # before numpy loads: impstab and the baseline with one BLAS thread, as the CLI runs
+
 import json
 import math
 import statistics

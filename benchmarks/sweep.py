@@ -47,6 +47,10 @@ extra keys.
 
 from __future__ import annotations
 
+from impstab._blas import prefer_single_thread
+
+prefer_single_thread()  # before numpy loads: impstab and the baseline with one BLAS thread, as the CLI runs
+
 import argparse
 import json
 import os
