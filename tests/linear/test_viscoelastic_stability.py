@@ -13,6 +13,17 @@ from impstab.linear.viscoelastic import ViscoelasticFamily
 SLS = {"law": "standard-linear-solid", "stiffening": 1.5, "relaxation_time": 2e-3}
 
 
+def _unmatched(e, a, er, ar) -> list:
+    """The eigenvalues of the full pencil ``(A, E)`` left after each of the reduced one's took its
+    nearest (each to 1e-8 relative)."""
+    lam = list(np.linalg.eigvals(np.linalg.solve(e, a)))
+    for r in np.linalg.eigvals(np.linalg.solve(er, ar)):
+        j = int(np.argmin(np.abs(np.array(lam) - r)))
+        assert abs(lam[j] - r) <= 1e-8 * max(abs(r), 1.0)
+        lam.pop(j)
+    return lam
+
+
 def _model(visco=SLS, **analysis):
     d = ring_model_dict()
     d["mount_rings"][0]["viscoelastic"] = dict(visco)
@@ -255,11 +266,7 @@ def test_reduced_family_drops_only_the_unreached_relaxation_roots():
     assert (full.n, small.n) == (30, 24)
     e, a = full.matrices(np.array([8000.0]))
     er, ar = small.matrices(np.array([8000.0]))
-    lam = list(np.linalg.eigvals(np.linalg.solve(e[0], a[0])))
-    for r in np.linalg.eigvals(np.linalg.solve(er[0], ar[0])):
-        j = int(np.argmin(np.abs(np.array(lam) - r)))
-        assert abs(lam[j] - r) <= 1e-8 * max(abs(r), 1.0)
-        lam.pop(j)
+    lam = _unmatched(e[0], a[0], er[0], ar[0])
     np.testing.assert_allclose(np.sort(np.real(lam)), [-1e3] * 3 + [-50.0] * 3, rtol=1e-8)
     from impstab.linear.critical import critical_load_family
 
@@ -311,11 +318,7 @@ def test_reduced_states_below_full_rank_drop_only_the_unreached_root():
     assert (full.n, small.n) == (18, 17)
     e, a = full.matrices(np.array([3000.0]))
     er, ar = small.matrices(np.array([3000.0]))
-    lam = list(np.linalg.eigvals(np.linalg.solve(e[0], a[0])))
-    for r in np.linalg.eigvals(np.linalg.solve(er[0], ar[0])):
-        j = int(np.argmin(np.abs(np.array(lam) - r)))
-        assert abs(lam[j] - r) <= 1e-8 * max(abs(r), 1.0)
-        lam.pop(j)
+    lam = _unmatched(e[0], a[0], er[0], ar[0])
     assert len(lam) == 1 and lam[0] == pytest.approx(-1 / tau, rel=1e-8)
 
 

@@ -234,12 +234,14 @@ class _SolveIvp(Integrator):
 
         const = problem.constant_load
 
-        def fun(t, z):
+        def loads_at(t):
             if const is None:
                 ld = problem.loads(np.array([t]))
-                thrust, spin = float(ld[0, 0]), float(ld[1, 0])
-            else:
-                thrust, spin = const
+                return float(ld[0, 0]), float(ld[1, 0])
+            return const
+
+        def fun(t, z):
+            thrust, spin = loads_at(t)
             out = np.empty(n)
             rhs_into(kind, arrays, yeq, np.ascontiguousarray(z, dtype=float), thrust, spin, out)
             return out
@@ -251,11 +253,7 @@ class _SolveIvp(Integrator):
             status = np.zeros(n, dtype=np.int64)
 
             def jac(t, z):
-                if const is None:
-                    ld = problem.loads(np.array([t]))
-                    thrust, spin = float(ld[0, 0]), float(ld[1, 0])
-                else:
-                    thrust, spin = const
+                thrust, spin = loads_at(t)
                 probe = np.ascontiguousarray(np.asarray(z, dtype=float)[None, :] + eye)
                 rhs_batch(kind, arrays, yeq, probe, thrust, spin, dz, status)
                 return dz.imag.T / COMPLEX_STEP
