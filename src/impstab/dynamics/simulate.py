@@ -16,8 +16,7 @@ from ..model.model import DOF_NAMES, Model
 from .growth import classify, fit_run
 from .integrators import Problem, get_integrator
 from .loading import Perturbation, as_thrust_history
-from .rhs import PITCH_LIMIT
-from .rhs import N_BODY
+from .rhs import N_BODY, PITCH_LIMIT
 from .system import pack_dynamics
 from .result import SimulationResult
 from .viscoelastic import augmented_roots, check_explicit_step, step_limit

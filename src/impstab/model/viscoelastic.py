@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["ViscoelasticLaw", "LAWS", "refuse_viscoelastic", "fit_prony", "prony_ratio", "FIT_POINTS_PER_DECADE", "FIT_DECADES_FRACTIONAL"]
+__all__ = ["ViscoelasticLaw", "LAWS", "fit_prony", "prony_ratio", "FIT_POINTS_PER_DECADE", "FIT_DECADES_FRACTIONAL"]
 
 Array = NDArray[np.float64]
 
@@ -262,14 +262,3 @@ class ViscoelasticLaw:
                f"{self.fit_error:.2e}") if self.fit_band_hz is not None else ""
         return f"{self.law}: {self.n_terms} Prony term(s){fit}"
 
-
-def refuse_viscoelastic(model, what: str) -> None:
-    """A one-line :class:`~impstab.errors.ModelError` when ``model`` has viscoelastic mounts and
-    ``what`` (an analysis) does not carry their internal variables."""
-    for i, m in enumerate(model.mounts):
-        if m.viscoelastic is not None:
-            from ..errors import ModelError
-
-            raise ModelError(f"mounts[{i}].viscoelastic", m.viscoelastic.law,
-                             f"{what} does not carry viscoelastic internal variables (not implemented); "
-                             "critical, modes, locus, response and simulate do")
