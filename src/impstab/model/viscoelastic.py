@@ -261,4 +261,3 @@ class ViscoelasticLaw:
         fit = (f", fitted over {self.fit_band_hz[0]:.4g}-{self.fit_band_hz[1]:.4g} Hz, max relative error "
                f"{self.fit_error:.2e}") if self.fit_band_hz is not None else ""
         return f"{self.law}: {self.n_terms} Prony term(s){fit}"
-
