@@ -115,17 +115,14 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
     blocks = []   # (rows from q (S, r, 6), force columns (S, 6, r), tau)
     if reduced:
         eye = np.broadcast_to(np.eye(6), (s, 6, 6))
+        if ranks is None:  # invariant under the rotation of the arms: from the first finite stack
+            ranks = _reduced_ranks(maps[int(np.argmax(np.isfinite(maps).all(axis=(1, 2, 3))))], terms)
         for tj, members in _groups(terms).items():
             js = [j for j, _ in members]
             gs = np.array([gj for _, gj in members])
             for j, gj in members:
                 weights[j] += gj
-            if ranks is not None:
-                rank = ranks[tj]
-            else:  # invariant under the rotation of the arms
-                row = int(np.argmax(np.isfinite(maps).all(axis=(1, 2, 3))))
-                sv = np.linalg.svd(maps[row, js].reshape(-1, 6), compute_uv=False)
-                rank = int((sv > 1e-12 * sv[0]).sum())
+            rank = ranks[tj]
             if rank == 6:
                 blocks.append((eye, np.einsum("v,svab->sab", gs, stiff[:, js]), tj))
                 continue
