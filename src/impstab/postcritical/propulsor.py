@@ -105,8 +105,7 @@ def _regions(ns) -> Callable[[NDArray], NDArray]:
         y = np.atleast_2d(np.asarray(states, dtype=complex))
         codes = [(np.abs(y[:, 4].real) >= pitch).astype(np.int64)[:, None]]
         if snub.size:
-            rot = _rotations(y[:, 3], y[:, 4], y[:, 5])                           # (N, 3, 3)
-            d = y[:, None, :3] + np.einsum("kab,ib->kia", rot, arms) - arms[None]
+            d = _deflections(y, arms)
             r2 = np.sum(d * d, axis=-1)                                          # analytic, no conjugate
             contact = r2.real > clear ** 2
             t = (np.sqrt(r2) - clear) / (SNUBBER_SMOOTHING * clear)
@@ -116,11 +115,13 @@ def _regions(ns) -> Callable[[NDArray], NDArray]:
     return region
 
 
-def _rotations(phi, theta, psi) -> NDArray:
-    """z-y-x Euler rotation matrices (body -> hull) of a batch of (complex) angles, (N, 3, 3)."""
+def _deflections(states: NDArray, arms: NDArray) -> NDArray:
+    """Mount deflections ``d = X_A + R r_i - r_i`` (hull frame, m; THEORY 7) of a batch of (real or
+    complex) states ``(N, >= 6)`` at arms ``r_i (mounts, 3)``: ``(N, mounts, 3)``."""
     from ..kinematics import euler_zyx_to_matrix
 
-    return np.moveaxis(np.asarray(euler_zyx_to_matrix(phi, theta, psi)), -1, 0)
+    rot = np.moveaxis(np.asarray(euler_zyx_to_matrix(states[:, 3], states[:, 4], states[:, 5])), -1, 0)  # (N, 3, 3)
+    return states[:, None, :3] + np.einsum("kab,ib->kia", rot, arms) - arms[None]
 
 
 def mount_peaks(ns, states: NDArray) -> tuple[float, float, bool]:
@@ -136,8 +137,7 @@ def mount_peaks(ns, states: NDArray) -> tuple[float, float, bool]:
     states = np.atleast_2d(np.asarray(states, dtype=float))
     pos = np.asarray(ns.system.arrays[0])
     laws = np.asarray(ns.system.arrays[4])
-    rot = _rotations(states[:, 3], states[:, 4], states[:, 5])                  # (k, 3, 3)
-    d = states[:, None, :3] + np.einsum("kab,ib->kia", rot, pos) - pos[None, :, :]
+    d = _deflections(states, pos)
     dn = np.linalg.norm(d, axis=-1)                                              # (k, mounts)
     loads = mount_loads(ns.system, np.zeros(ns.n_states), states)
     force = np.linalg.norm(loads[:, :, :3], axis=-1)
