@@ -504,6 +504,8 @@ def _conjugate_groups(lam: NDArray[np.complex128], vectors: NDArray | None = Non
         partner = np.argmin(np.where(np.isnan(dist), np.inf, dist), axis=-1)
         near = np.take_along_axis(dist, partner[..., None], axis=-1)[..., 0] <= _PAIR_TOL * scale
         if vectors is not None:
+            from .tracking import mac_of_pairs
+
             for r in range(lam.shape[0]):
                 cand = dist[r] <= _PAIR_TOL * scale                      # (a, b)
                 multi = cand.sum(axis=1) > 1
@@ -511,11 +513,8 @@ def _conjugate_groups(lam: NDArray[np.complex128], vectors: NDArray | None = Non
                     # the MAC of conj(v_a) and v_b, for the candidate pairs only (a column
                     # with one candidate keeps it: the nearest conjugate)
                     a, b = np.nonzero(cand & multi[:, None])
-                    va, vb = vectors[r][:, a], vectors[r][:, b]
-                    num = np.abs((va * vb).sum(axis=0)) ** 2
-                    den = (np.abs(va) ** 2).sum(axis=0) * (np.abs(vb) ** 2).sum(axis=0)
                     fit = np.full(cand.shape, -1.0)
-                    fit[a, b] = num / np.where(den > 0, den, 1.0)
+                    fit[a, b] = mac_of_pairs(np.conj(vectors[r][:, a]), vectors[r][:, b])
                     partner[r, multi] = np.argmax(fit[multi], axis=1)
         upper = lam.imag > _PAIR_TOL * scale
     first = np.broadcast_to(np.arange(k), partner.shape)

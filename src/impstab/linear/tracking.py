@@ -6,7 +6,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
-__all__ = ["mac", "track_modes"]
+__all__ = ["mac", "mac_of_pairs", "track_modes"]
 
 #: weight of the relative eigenvalue distance against the MAC (which lies in [0, 1])
 DISTANCE_WEIGHT = 20.0
@@ -16,6 +16,14 @@ def mac(a: NDArray, b: NDArray) -> NDArray[np.float64]:
     """Modal assurance criterion ``|a_i^H b_j|^2 / (|a_i|^2 |b_j|^2)`` between columns."""
     num = np.abs(a.conj().T @ b) ** 2
     den = np.outer((np.abs(a) ** 2).sum(0), (np.abs(b) ** 2).sum(0))
+    return num / np.where(den > 0, den, 1.0)
+
+
+def mac_of_pairs(a: NDArray, b: NDArray) -> NDArray[np.float64]:
+    """The MAC of each column of ``a`` with the same column of ``b`` (the diagonal of
+    :func:`mac` without the rest of the matrix)."""
+    num = np.abs((a.conj() * b).sum(0)) ** 2
+    den = (np.abs(a) ** 2).sum(0) * (np.abs(b) ** 2).sum(0)
     return num / np.where(den > 0, den, 1.0)
 
 
