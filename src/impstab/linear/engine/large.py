@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from ..classify import classify_eigenvalues
 from ..eigen import cluster_participation
+from ...errors import NumericalError
 from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_UNSTABLE
 
 __all__ = ["LARGE_ORDER", "BASIS", "TRUNCATION_TOLERANCE", "reducible", "modal_basis", "reduced_problem", "full_onset",
@@ -46,6 +47,12 @@ LARGE_ORDER = 96
 BASIS = 12
 #: relative agreement of the onsets with m and 2 m modes that accepts the truncation
 TRUNCATION_TOLERANCE = 1e-4
+#: relative move of a shift-invert shift that meets an exactly singular factorization (at a
+#: coalescence the cluster's mean is the double eigenvalue): it must lift the smallest singular
+#: value of ``K(p) - sigma M`` clear of the rounding of its entries (``eps max|K|``, about 1e-7 of a
+#: 1e9 N/m beam mesh against eigenvalues near 1e3 1/s^2); the subspace iteration then still
+#: gains the ratio of this distance to the next eigenvalue's (about 1e-6) per step
+SHIFT_NUDGE = 1e-6
 
 
 def reducible(problem) -> bool:
@@ -98,15 +105,31 @@ class _Pencil:
         self.sparse = np.count_nonzero(self.k0) < 0.1 * self.k0.size
 
     def _factor(self, p: float, sigma: float):
-        a = self.k0 + p * self.k1 - sigma * self.mass
-        if self.sparse:
-            import scipy.sparse as sparse
-            import scipy.sparse.linalg as spla
+        """``(solve, sigma)``: solves with the LU of ``K(p) - sigma M``.
 
-            lu = spla.splu(sparse.csc_matrix(a))
-            return lambda b, trans="N": lu.solve(b, trans=trans)
-        lu = sla.lu_factor(a)
-        return lambda b, trans="N": sla.lu_solve(lu, b, trans=0 if trans == "N" else 1)
+        Shift-invert wants ``sigma`` next to the cluster, and at a coalescence its mean is the
+        double eigenvalue itself: when the factorization meets an exactly zero pivot there, the
+        shift moves by :data:`SHIFT_NUDGE` of ``|sigma|`` (of ``|p| max|K1| / max|M|``, the load's
+        share of the eigenvalues, at a divergence's ``sigma = 0``); the returned ``sigma`` is the
+        one factored (the iteration only needs it near the cluster).
+        """
+        size = abs(sigma) if sigma != 0.0 else abs(p) * np.abs(self.k1).max() / np.abs(self.mass).max()
+        for nudge in (0.0, SHIFT_NUDGE, -SHIFT_NUDGE):
+            s = sigma + nudge * size
+            a = self.k0 + p * self.k1 - s * self.mass
+            if self.sparse:
+                import scipy.sparse as sparse
+                import scipy.sparse.linalg as spla
+
+                try:
+                    lu = spla.splu(sparse.csc_matrix(a))
+                except RuntimeError:  # "Factor is exactly singular"
+                    continue
+                return (lambda b, trans="N": lu.solve(b, trans=trans)), s
+            lu = sla.lu_factor(a, check_finite=False)
+            if np.all(np.diag(lu[0]) != 0.0):
+                return (lambda b, trans="N": sla.lu_solve(lu, b, trans=0 if trans == "N" else 1)), s
+        raise NumericalError(f"K(p) - sigma M is exactly singular at p = {p:.10g} for three shifts near {sigma:.6g}")
 
     def cluster(self, p: float, sigma: float, x: Array, y: Array, iterations: int = 30):
         """Right and left bases of the cluster near ``sigma`` at ``p``, and ``C``, ``B``.
@@ -119,7 +142,7 @@ class _Pencil:
         changing less (the rounding floor; each step multiplies the error by the ratio of the
         cluster's distance to ``sigma`` to that of the next eigenvalue, tiny near a coalescence).
         """
-        solve = self._factor(p, sigma)
+        solve, sigma = self._factor(p, sigma)
         eye = np.eye(x.shape[1])
         prev, change = None, np.inf
         for _ in range(iterations):
