@@ -484,44 +484,53 @@ def matching_order(ref: NDArray[np.complex128], lam: NDArray[np.complex128]) -> 
 
 
 def _conjugate_groups(lam: NDArray[np.complex128], vectors: NDArray | None = None) -> list[NDArray[np.int64]]:
-    """Columns of a tracked set that form one mode: linked where one is the conjugate of another.
+    """Columns of a tracked set that form one mode: each upper-half column and its conjugate partner.
 
-    ``vectors (rows, S, k)``: where several columns hold the conjugate value (identical planes that
-    one group of dofs carries), the partner is the one whose eigenvector is the conjugate of the
-    column's own (largest MAC), not the first of them.
+    A column's partner is the column holding its conjugate value, decided once for the whole
+    locus: the partner it has most often at the thrusts where that partner is unambiguous (one
+    column within the pairing tolerance), else most often over all thrusts, and never a column
+    another one already took. ``vectors (rows, S, k)``: where several columns hold the conjugate
+    value (identical planes that one group of dofs carries, or two pairs about to merge), the
+    partner at that thrust is the one whose eigenvector is the conjugate of the column's own
+    (one-to-one assignment of largest MAC), not the first of them.
     """
     k = lam.shape[1]
-    label = np.arange(k)
-
-    def root(i):
-        while label[i] != i:
-            i = label[i]
-        return i
-
     scale = max(float(np.nanmax(np.abs(lam))) if lam.size else 1.0, 1e-300)
     with np.errstate(invalid="ignore"):
         dist = np.abs(lam[:, :, None] - np.conj(lam)[:, None, :])  # (rows, a, b)
+        cand = dist <= _PAIR_TOL * scale
         partner = np.argmin(np.where(np.isnan(dist), np.inf, dist), axis=-1)
-        near = np.take_along_axis(dist, partner[..., None], axis=-1)[..., 0] <= _PAIR_TOL * scale
+        unique = cand.sum(axis=-1) == 1
         if vectors is not None:
+            from scipy.optimize import linear_sum_assignment
+
             from .tracking import mac_of_pairs
 
             for r in range(lam.shape[0]):
-                cand = dist[r] <= _PAIR_TOL * scale                      # (a, b)
-                multi = cand.sum(axis=1) > 1
+                multi = ~unique[r] & cand[r].any(axis=1)
                 if multi.any():
-                    # the MAC of conj(v_a) and v_b, for the candidate pairs only (a column
-                    # with one candidate keeps it: the nearest conjugate)
-                    a, b = np.nonzero(cand & multi[:, None])
-                    fit = np.full(cand.shape, -1.0)
+                    a, b = np.nonzero(cand[r] & multi[:, None])
+                    fit = np.full((k, k), -1.0)
                     fit[a, b] = mac_of_pairs(np.conj(vectors[r][:, a]), vectors[r][:, b])
-                    partner[r, multi] = np.argmax(fit[multi], axis=1)
+                    rows = np.flatnonzero(multi)
+                    _, cols = linear_sum_assignment(fit[rows], maximize=True)
+                    partner[r, rows] = cols
         upper = lam.imag > _PAIR_TOL * scale
     first = np.broadcast_to(np.arange(k), partner.shape)
-    linked = upper & near & (partner != first)
-    for a, b in set(zip(first[linked].tolist(), partner[linked].tolist())):
-        ra, rb = root(a), root(b)
-        if ra != rb:
-            label[max(ra, rb)] = min(ra, rb)
-    roots = np.array([root(i) for i in range(k)])
-    return [np.flatnonzero(roots == r) for r in np.unique(roots)]
+    linked = upper & cand.any(axis=-1) & (partner != first)
+    label = np.arange(k)
+    taken = np.zeros(k, dtype=bool)
+    for a in range(k):
+        rows = linked[:, a]
+        if taken[a] or not rows.any():
+            continue
+        sure = rows & unique[:, a]
+        votes = np.bincount(partner[sure if sure.any() else rows, a], minlength=k)
+        votes[taken | (label != np.arange(k))] = 0
+        votes[a] = 0
+        if votes.max() == 0:
+            continue
+        b = int(np.argmax(votes))
+        taken[a] = taken[b] = True
+        label[max(a, b)] = min(a, b)
+    return [np.flatnonzero(label == r) for r in np.unique(label)]
