@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
+from scipy.optimize import brentq, linear_sum_assignment
 
 import impstab
 from impstab.kinematics import rigid_map6
@@ -104,9 +104,17 @@ def test_symmetric_layout_keeps_its_two_planes_in_the_locus():
     body = grown.body_branches()
     assert body.branch_labels() == plain.branch_labels()
     assert np.array_equal(body.mode, plain.mode)
-    # column by column the same tracks, up to the beams' inertia (a 3e-3 mass share)
+    # column by column the same tracks below the onset, up to the beams' inertia (a 3e-3 mass
+    # share); past a coalescence which of the two merged branches takes the growing root is no
+    # continuity's to say: there the same eigenvalues, row by row
     scale = np.abs(plain.eigenvalues).max()
-    assert np.abs(body.eigenvalues - plain.eigenvalues).max() < 1e-2 * scale
+    stable = np.all(plain.eigenvalues.real < 1e-9 * scale, axis=1) & np.all(body.eigenvalues.real < 1e-9 * scale, axis=1)
+    assert stable[:5].all() and not stable[-1]
+    assert np.abs(body.eigenvalues[stable] - plain.eigenvalues[stable]).max() < 1e-2 * scale
+    for b, p in zip(body.eigenvalues[~stable], plain.eigenvalues[~stable]):
+        dist = np.abs(b[:, None] - p[None, :])
+        rows, cols = linear_sum_assignment(dist)
+        assert dist[rows, cols].max() < 1e-2 * scale
 
 
 def test_the_roll_mode_of_the_decoupling_check_is_a_body_mode():
@@ -122,14 +130,35 @@ def test_the_roll_mode_of_the_decoupling_check_is_a_body_mode():
     assert check.roll_mode == body[int(np.argmax(md.participation[body, 3]))]
 
 
-def test_modes_with_compressible_fluid_and_massive_beams_are_refused_in_one_line():
-    from impstab.errors import ModelError
-
+def _compressible(density: float):
     data = _model()
+    data["analysis"]["linearization"] = "classical"
     for m in data["mounts"]:
-        m["beam"]["density"] = 1100.0
+        m["beam"]["density"] = density
     data["hull"] = {"radius": 0.2, "length": 0.8, "center": [0.1, 0.0, 0.0]}
     data["fluid"] = {"model": "baffled-cylinder", "density": 1025.0, "sound_speed": 1500.0}
-    with pytest.raises(ModelError) as info:
-        impstab.modes(model_from_dict(data), 0.0)
-    assert info.value.field == "fluid.sound_speed" and "\n" not in str(info.value)
+    return model_from_dict(data)
+
+
+def test_modes_with_compressible_fluid_and_massive_beams_take_the_fluid_at_each_mode_frequency():
+    from impstab.linear.mount_dofs import mount_dofs
+
+    model = _compressible(1100.0)
+    md = impstab.modes(model, 0.0)
+    assert md.internal_dofs > 0 and md.kind[:6] == ["body"] * 6
+    dofs = mount_dofs(model)
+    k6 = model.elastic_stiffness
+    # each mode solves the grown pencil assembled here with the fluid's added mass and radiation
+    # damping at that mode's own frequency
+    for lam in md.eigenvalues[:8]:
+        added, radiation = model.fluid.coefficients_at(abs(lam.imag) / (2 * np.pi))
+        m, d, g, k = (a[0] for a in dofs.augment((model.body.mass_matrix() + added)[None], radiation[None],
+                                                  np.zeros((1, 6, 6)), k6[None]))
+        pencil = lam * lam * m + lam * d + k
+        sv = np.linalg.svd(pencil, compute_uv=False)
+        assert sv[-1] / sv[0] < 1e-11, (lam, sv[-1] / sv[0])
+    # the radiation damping damps every body mode (a pair in the left half-plane)
+    assert np.all(md.eigenvalues[:6].real < 0)
+    # nearly massless beams: the body modes of the massless-beam model (its own 6-dof fluid iteration)
+    light, massless = impstab.modes(_compressible(1e-6), 0.0), impstab.modes(_compressible(0.0), 0.0)
+    np.testing.assert_allclose(light.eigenvalues[:6], massless.eigenvalues, rtol=1e-8)

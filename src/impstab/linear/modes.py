@@ -17,7 +17,8 @@ row still sums to 1. The dominant dof of a mode is its largest share.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -285,7 +286,11 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
     damping at its own frequency, iterated to consistency (fixed point on the frequency).
     """
     if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: the grown system
-        return _grown_modes(model, thrust, linearization)
+        grown = _grown_modes(model, thrust, linearization)
+        if not model.fluid.compressible:
+            return grown
+        return _fluid_consistent(model, thrust, linearization, grown,
+                                 lambda f: _grown_modes(model, thrust, linearization, f))
     if model.is_viscoelastic:  # internal variables: the augmented first-order system
         from .viscoelastic import viscoelastic_modes
 
@@ -296,27 +301,35 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
     return _fluid_consistent(model, thrust, linearization, base)
 
 
-def _fluid_consistent(model: Model, thrust: float, linearization: str | None, base: ModalResult) -> ModalResult:
+def _fluid_consistent(model: Model, thrust: float, linearization: str | None, base: ModalResult,
+                      solve: Callable[[float], ModalResult] | None = None) -> ModalResult:
     """Each mode with the fluid coefficients at its own frequency (fixed point on the frequency).
 
-    Modes that converge to one frequency share one eigenproblem there: each takes a different
-    eigenvalue of it (the nearest not taken yet), so a repeated eigenvalue is listed as often as
-    its multiplicity, with independent shapes, never one mode twice.
+    ``base``: the modes with the coefficients at 0 Hz; ``solve(f)``: every mode with the
+    coefficients at ``f`` Hz (default: the body's 6 dofs; the grown system of massive beam mounts
+    passes its own). Modes that converge to one frequency share one eigenproblem there: each takes
+    a different eigenvalue of it (the nearest not taken yet), so a repeated eigenvalue is listed as
+    often as its multiplicity, with independent shapes, never one mode twice.
     """
     from .linearize import ModelFamily
 
+    def body_modes(f: float) -> ModalResult:
+        fam = ModelFamily(model, linearization, fluid_frequency=f)
+        m, d, g, k, u0, r0 = fam.evaluate(np.array([thrust]))
+        return modes_of_system(LinearSystem(m[0], d[0], g[0], k[0], thrust, fam.linearization, u0[0], r0[0]))
+
+    solve = body_modes if solve is None else solve
     solved: dict[float, ModalResult] = {}
 
     def at(f: float) -> ModalResult:
         if f not in solved:
-            fam = ModelFamily(model, linearization, fluid_frequency=f)
-            m, d, g, k, u0, r0 = fam.evaluate(np.array([thrust]))
-            solved[f] = modes_of_system(LinearSystem(m[0], d[0], g[0], k[0], thrust, fam.linearization, u0[0], r0[0]))
+            solved[f] = solve(f)
         return solved[f]
 
     taken: dict[float, set[int]] = {}
     n = len(base.eigenvalues)
     vals, shapes, part = base.eigenvalues.copy(), base.shapes.copy(), base.participation.copy()
+    internal = None if base.internal_share is None else base.internal_share.copy()
     for j in range(n):
         target, f = vals[j], abs(vals[j].imag) / (2 * np.pi)
         for _ in range(50):
@@ -332,8 +345,11 @@ def _fluid_consistent(model: Model, thrust: float, linearization: str | None, ba
             f = f_new
         taken.setdefault(f, set()).add(i)
         vals[j], shapes[:, j], part[j] = res.eigenvalues[i], res.shapes[:, i], res.participation[i]
+        if internal is not None:
+            internal[j] = res.internal_share[i]
     order = np.lexsort((vals.real, np.abs(vals.imag)))
-    return ModalResult(base.thrust, base.linearization, vals[order], shapes[:, order], part[order])
+    return replace(base, eigenvalues=vals[order], shapes=shapes[:, order], participation=part[order],
+                   internal_share=None if internal is None else internal[order])
 
 
 #: relative change of a mode's frequency that ends the fluid fixed point; modes whose frequencies
@@ -341,19 +357,16 @@ def _fluid_consistent(model: Model, thrust: float, linearization: str | None, ba
 FREQUENCY_TOLERANCE = 1e-12
 
 
-def _grown_modes(model: Model, thrust: float, linearization: str | None) -> ModalResult:
+def _grown_modes(model: Model, thrust: float, linearization: str | None, fluid_frequency: float = 0.0) -> ModalResult:
     """Modes of the body with the internal dofs of its massive beam mounts
     (:mod:`impstab.linear.mount_dofs`): every eigenvalue of the grown system with ``omega >= 0``;
     shapes and the decoupling table of the body dofs, the internal share of each mode's kinetic
-    energy beside them."""
-    from ..errors import ModelError, NumericalError
+    energy beside them. ``fluid_frequency`` (Hz): where compressible fluid coefficients are taken
+    (they act on the body's dofs only)."""
+    from ..errors import NumericalError
     from .linearize import ModelFamily
 
-    if model.fluid.compressible:
-        raise ModelError("fluid.sound_speed", model.fluid.sound_speed,
-                         "the modes of a model with beam mounts with mass take the fluid incompressible only: "
-                         "leave sound_speed out (or use density = 0 for the massless beams)")
-    fam = ModelFamily(model, linearization)
+    fam = ModelFamily(model, linearization, fluid_frequency=fluid_frequency)
     m, d, g, k = (np.asarray(a[0], dtype=float) for a in fam.matrices(np.array([float(thrust)])))
     if not np.isfinite(k).all():
         raise NumericalError(f"no static equilibrium found at thrust {thrust:.6g} N: the mounts cannot carry this thrust")
