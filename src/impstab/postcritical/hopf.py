@@ -555,6 +555,15 @@ def _degeneracy(jac, mass, spec: Spectrum, idx, lam, kappa, dlam, scale) -> tupl
     # a neighbour closer than the resolution with one eigenvector: a Jordan block (collision);
     # with two independent eigenvectors: a semisimple double pair unless their Gram matrix is singular
     defective = kappa >= KAPPA_DEFECTIVE or (null < 2 and dist <= COALESCENCE_DISTANCE)
+    # in a reversible family (spectrum symmetric about the imaginary axis) a simple pair cannot
+    # leave the axis: its mirror image would be a second eigenvalue next to it. A pair that
+    # crosses there does so by colliding with its neighbour, however far apart rounding leaves
+    # the two computed at the refined point (about sqrt(eps_J) of the radius, near the resolution
+    # of COALESCENCE_DISTANCE)
+    speed = abs(dlam) if math.isfinite(abs(dlam)) else math.inf
+    crossing = math.isfinite(dlam.real) and abs(dlam.real) > TRANSVERSALITY_TOLERANCE * max(speed, 1e-300)
+    near = others.size > 0 and float(np.min(np.abs(others - lam))) <= NEAR_RESONANCE * abs(lam)
+    defective = defective or (symmetric_spectrum and null < 2 and crossing and near)
     if null >= 2:
         right = vh[-null:].conj().T
         left = u[:, -null:]
