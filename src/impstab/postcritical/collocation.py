@@ -17,6 +17,7 @@ superconvergent: ``O(h^2m)`` at the mesh points and in the period, ``O(h^(m+1))`
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import lru_cache
 
 import numpy as np
@@ -53,9 +54,7 @@ class Scheme:
 
     def basis(self, s: Array) -> Array:
         """``L_j(s)`` for local coordinates ``s`` (any shape) -> ``s.shape + (m + 1,)``."""
-        s = np.asarray(s, dtype=float)
-        pw = s[..., None] ** np.arange(self.degree + 1)
-        return pw @ self.power
+        return _lagrange(self.nodes, np.asarray(s, dtype=float), 0)
 
     def basis_derivative(self, s: Array, order: int = 1) -> Array:
         s = np.asarray(s, dtype=float)
@@ -74,21 +73,58 @@ def scheme(degree: int) -> Scheme:
         raise ValueError(f"degree = {degree!r}: must be an integer from 2 to 7")
     m = int(degree)
     nodes = np.linspace(0.0, 1.0, m + 1)
-    vander = nodes[:, None] ** np.arange(m + 1)[None, :]
-    power = np.linalg.inv(vander)                 # L_j(s) = sum_k power[k, j] s^k
+    # L_j(s) = sum_k power[k, j] s^k: the inverse of the nodes' Vandermonde matrix in exact rational
+    # arithmetic (its condition number reaches 1e5 at degree 7, and a float inverse loses that much)
+    exact = [Fraction(j, m) for j in range(m + 1)]
+    power = np.array(_rational_inverse([[x ** k for k in range(m + 1)] for x in exact]), dtype=float)
     g, gw = np.polynomial.legendre.leggauss(m)
     points = 0.5 * (g + 1.0)
-    sch = Scheme(m, nodes, points, np.zeros((m, m + 1)), np.zeros((m, m + 1)), np.zeros((m + 1, m + 1)),
-                 np.zeros(m + 1), np.zeros(m + 1), power, 0.0)
-    value = sch.basis(points)
-    derivative = sch.basis_derivative(points)
-    node_derivative = sch.basis_derivative(nodes)
-    k = np.arange(m + 1)
-    weights = (1.0 / (k + 1.0)) @ power
-    top = float(np.prod(np.arange(1, m + 1))) * power[m]
+    # the local matrices from the product form of the Lagrange polynomials (a few eps; the power
+    # form sums coefficients of size 1e3 with alternating signs)
+    value = _lagrange(nodes, points, 0)
+    derivative = _lagrange(nodes, points, 1)
+    node_derivative = _lagrange(nodes, nodes, 1)
+    weights = 0.5 * gw @ value                     # Gauss-Legendre with m points: exact to degree 2m - 1
+    top = np.array([float(np.prod(np.arange(1, m + 1)) / np.prod([xj - xi for xi in exact if xi != xj]))
+                    for xj in exact])
     fine = np.linspace(0.0, 1.0, 2001)
     err = float(np.max(np.abs(np.prod(fine[:, None] - points[None, :], axis=1)))) / float(np.prod(np.arange(1, m + 2)))
     return Scheme(m, nodes, points, value, derivative, node_derivative, weights, top, power, err)
+
+
+def _lagrange(nodes: Array, s: Array, order: int) -> Array:
+    """``L_j(s)`` (``order = 0``) or ``L_j'(s)`` (1) of the nodes, ``s.shape + (m + 1,)``, from the
+    product form: ``L_j = prod_{i != j} (s - x_i) / (x_j - x_i)`` and
+    ``L_j' = sum_{k != j} 1 / (x_j - x_k) prod_{i != j, k} (s - x_i) / (x_j - x_i)``."""
+    n = nodes.size
+    diff = s[..., None] - nodes                                        # (..., n)
+    out = np.zeros(s.shape + (n,))
+    for j in range(n):
+        others = [i for i in range(n) if i != j]
+        scale = nodes[j] - nodes[others]
+        if order == 0:
+            out[..., j] = np.prod(diff[..., others] / scale, axis=-1)
+            continue
+        for k in others:
+            rest = [i for i in others if i != k]
+            out[..., j] += np.prod(diff[..., rest] / (nodes[j] - nodes[rest]), axis=-1) / (nodes[j] - nodes[k])
+    return out
+
+
+def _rational_inverse(rows: list[list[Fraction]]) -> list[list[Fraction]]:
+    """The inverse of a square matrix of fractions (Gauss-Jordan, exact)."""
+    n = len(rows)
+    a = [list(r) + [Fraction(int(i == j)) for j in range(n)] for i, r in enumerate(rows)]
+    for c in range(n):
+        piv = next(r for r in range(c, n) if a[r][c] != 0)
+        a[c], a[piv] = a[piv], a[c]
+        inv = 1 / a[c][c]
+        a[c] = [v * inv for v in a[c]]
+        for r in range(n):
+            if r != c and a[r][c] != 0:
+                f = a[r][c]
+                a[r] = [v - f * w for v, w in zip(a[r], a[c])]
+    return [r[n:] for r in a]
 
 
 def interval_nodes(intervals: int, degree: int) -> NDArray[np.intp]:
