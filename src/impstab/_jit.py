@@ -40,12 +40,13 @@ import sys
 import threading
 from collections.abc import Callable
 from contextlib import nullcontext
-from time import perf_counter
+from time import thread_time
 from typing import Any
 
 __all__ = ["njit", "objmode", "on_compile", "require_compiled", "compiled", "BUDGET_S", "Kernel"]
 
-#: seconds of interpreted kernel time after which the process compiles: numba's import, its code
+#: seconds of interpreted kernel time after which the process compiles (CPU time of the calling
+#: thread, so that a loaded machine does not make the same analysis compile): numba's import, its code
 #: generator's start and the cache loads of the linear kernels cost about 0.8 s of CPU once, so
 #: an analysis that interprets for less than that is done sooner interpreted (a single model's
 #: critical thrust takes 0.02-0.65 s interpreted); past it, compiling is cheaper than going on)
@@ -126,7 +127,7 @@ def _interpret(kernel: Kernel, args: tuple, kwargs: dict) -> Any:
         if kernel.dispatcher is not None:
             return kernel.dispatcher(*args, **kwargs)
     _local.depth = 1
-    start = perf_counter()
+    start = thread_time()
     retry = False
     try:
         return kernel.interpreted(*args, **kwargs)
@@ -134,7 +135,7 @@ def _interpret(kernel: Kernel, args: tuple, kwargs: dict) -> Any:
         retry = True  # IEEE arithmetic where Python raises: the compiled kernel's answer
     finally:
         _local.depth = 0
-        _spent += perf_counter() - start
+        _spent += thread_time() - start
         if retry or (_spent > BUDGET_S and _policy() == "auto"):
             require_compiled(force=retry)
     return kernel.dispatcher(*args, **kwargs)
