@@ -92,8 +92,8 @@ def test_small_amplitude_growth_equals_least_stable_eigenvalue(damped_example, f
     assert (lam.real > 0) == (factor > 1) and res.classification == ("supercritical" if factor > 1 else "subcritical")
     if factor > 1:
         assert abs(fit.linear_rate - lam.real) < 1e-9 * abs(lam.real)
-    assert abs(fit.rate - lam.real) < 1e-5 * abs(lam.real)
-    assert abs(fit.frequency_hz - lam.imag / (2 * np.pi)) < 1e-6 * lam.imag / (2 * np.pi)
+    assert abs(fit.rate - lam.real) < 1e-6 * abs(lam.real)  # measured 6e-8 (0.9), 3e-8 (1.1)
+    assert abs(fit.frequency_hz - lam.imag / (2 * np.pi)) < 1e-9 * lam.imag / (2 * np.pi)  # measured 2e-11
 
 
 def _rod(elements: int):
@@ -175,11 +175,9 @@ def test_radau_agrees_with_hamming_and_the_modes_round_trip(tmp_path):
     scale = np.max(np.abs(rad.deviation), axis=0)
     assert np.allclose(ham.time, rad.time)
     err = np.max(np.abs(ham.deviation - rad.deviation) / scale)
-    print("hamming against radau, body states", err)
-    assert err < 1e-5
+    assert err < 1e-5  # measured 6.9e-7
     # the fastest kept modes (40 steps a period, some hundred periods) carry Hamming's phase error
     err = np.max(np.abs(ham.beam_modes - rad.beam_modes)) / np.max(np.abs(rad.beam_modes))
-    print("hamming against radau, modal coordinates", err)
     assert err < 1e-4  # measured 1.6e-5
     assert np.max(np.abs(rad.beam_modes)) > 0 and np.all(rad.beam_mode_mounts == 0)
     path = tmp_path / "r.nc"

@@ -15,9 +15,17 @@ too stiff for an explicit step. The time histories keep the modes below :data:`S
 the body's highest frequency (at rest, each mount as its static stiffness, the beams' constraint
 mass included). The dropped modes stay in the constraint modes as their static (mass) part, so the
 statics and the low-frequency inertia are exact and only the dynamic amplification of modes far
-above the body's is lost. On ``examples/imp_beam_mounts.toml`` the critical thrust of the kept
-modes is within 2e-5 (relative) of the stability analysis's (docs/mounts.md gives the
-measurement).
+above the body's is lost. On ``examples/imp_beam_mounts.toml`` (first internal modes at 31 times
+the body's highest frequency) the time histories keep three modes per beam, and the critical
+thrust of the body with them is within 1.2e-8 (relative) of the stability analysis's with 168
+modes (1.2e-7 with none; docs/mounts.md gives the table).
+
+Mount loads: a massive beam's reported load (:func:`~impstab.dynamics.rhs.mount_loads_series`)
+is that of its static tip stiffness and dampers at the body-end deflection, the quasi-static load
+both of its ends carry; the beam's inertia force on the body
+``f = -(m_tt - m_te m_te^T) a + m_te Omega^2 eta`` is not in it, and the hull-end reaction differs
+from the body-end force by the beam's own inertia (the forced response reports the exact hull-end
+force).
 
 The step: the default fixed step takes :data:`~impstab.dynamics.simulate.STEPS_PER_PERIOD` steps
 per period of the fastest root of the grown linear system (:func:`fastest_root`), which is the
