@@ -164,6 +164,14 @@ def test_cli_refuses_a_stiff_explicit_step_in_one_line(capsys, tmp_path):
     _, err = capsys.readouterr()
     assert code == 2 and err.count("\n") == 1 and err.startswith("impstab: error: --dt = 0.001")
     assert "internal mode" in err and "radau" in err and not list(tmp_path.iterdir())
+    # the default step runs and the file carries the modal coordinates
+    code = main(["simulate", str(EXAMPLES / "imp_beam_mounts.toml"), "--thrust", "1000", "--duration", "0.02",
+                 "--no-plot", "-o", str(out)])
+    assert code == 0 and out.exists()
+    import xarray as xr
+
+    with xr.open_dataset(out) as ds:
+        assert ds.sizes["beam_mode"] == 12 and list(np.unique(ds["beam_mode_mount"].values)) == [0, 1, 2, 3]
 
 
 def test_radau_agrees_with_hamming_and_the_modes_round_trip(tmp_path):

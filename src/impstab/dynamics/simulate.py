@@ -197,7 +197,9 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
     integrator : {"hamming", "gill", "dop853", "rk45", "radau", "lsoda"}
     dt : float, optional
         Fixed step (s) of ``hamming`` and ``gill``; default: ``STEPS_PER_PERIOD`` steps per period of
-        the fastest mode of the linearized system. A larger step warns (:class:`StepSizeWarning`).
+        the fastest mode of the linearized system (the kept modes of massive beam mounts included).
+        A larger step warns (:class:`StepSizeWarning`); one beyond the method's stability limit on
+        a viscoelastic relaxation or a kept beam mode is refused (:class:`~impstab.errors.ModelError`).
         For the SciPy methods it is the largest step (default unlimited). The step is shortened
         slightly so that samples and the end of the run fall on steps.
     perturbation : Perturbation, dict or None
