@@ -10,7 +10,7 @@
   ``EA u'(L) = -M u''(L)`` with ``u = sin(beta x)``: ``beta L tan(beta L) = rho A L / M``,
   against the simulated free vibration, converging with the elements;
 * an explicit step beyond the stability limit of the fastest kept mode is refused in one line;
-  radau (exact complex-step Jacobian) agrees with hamming.
+  radau and lsoda (exact complex-step Jacobian) agree with hamming.
 """
 
 from dataclasses import replace
@@ -188,6 +188,8 @@ def test_radau_agrees_with_hamming_and_the_modes_round_trip(tmp_path):
     err = np.max(np.abs(ham.beam_modes - rad.beam_modes)) / np.max(np.abs(rad.beam_modes))
     assert err < 1e-4  # measured 1.6e-5
     assert np.max(np.abs(rad.beam_modes)) > 0 and np.all(rad.beam_mode_mounts == 0)
+    lsoda = impstab.simulate(model, 0.0, 0.05, "lsoda", rtol=1e-10, **kw)
+    assert np.max(np.abs(lsoda.deviation - rad.deviation) / scale) < 1e-6  # measured 6e-8
     path = tmp_path / "r.nc"
     rad.to_xarray().to_netcdf(path)
     import xarray as xr
