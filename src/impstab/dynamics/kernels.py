@@ -114,6 +114,7 @@ def _advance(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist,
     pos, kmat, cmat, flags, laws = arrays[0], arrays[1], arrays[2], arrays[3], arrays[4]
     par, minv, damp6, amat = arrays[5], arrays[6], arrays[7], arrays[8]
     vstart, vpar = arrays[9], arrays[10]
+    bpos, bmat, bstart, bmode, mass6 = arrays[11], arrays[12], arrays[13], arrays[14], arrays[15]
     written = 0
     errmax = -1.0
     quiet = 0
@@ -198,8 +199,8 @@ def _advance(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist,
             if kind == KIND_LINEAR:
                 st = linear_rhs(amat, tmp, dest)
             else:
-                st = model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, yeq, tmp, loads[0, jl],
-                               loads[1, jl], dest, rot, jinv, ws)
+                st = model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, bpos, bmat, bstart,
+                               bmode, mass6, yeq, tmp, loads[0, jl], loads[1, jl], dest, rot, jinv, ws)
             if stage == -1:
                 if st != OK:
                     status = st

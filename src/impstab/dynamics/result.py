@@ -34,7 +34,9 @@ class SimulationResult:
     equilibrium : (12,) the static equilibrium ``(X_A, Xi, 0)`` at ``T(0)``
     thrust : (k,) thrust at the samples (N)
     mount_loads : (k, n_mounts, 6) force of each mount on the body (N, hull frame) and its moment
-        (N m; non-zero for mounts with rotational stiffness only)
+        (N m; non-zero for mounts with rotational stiffness only); for a massive beam mount the
+        load of its static tip stiffness (and dampers) at the body-end deflection, without the
+        beam's inertia force (:mod:`impstab.dynamics.beam_mounts`)
     error_estimate : (k,) or None
         Hamming's relative local error estimate, largest over each sampling interval.
     completed : bool
@@ -49,6 +51,14 @@ class SimulationResult:
         without viscoelastic mounts.
     internal_mounts : (n_terms,) int array or None
         The mount of each Prony term.
+    beam_modes, beam_mode_rates : (k, n_modes) or None
+        The kept fixed-interface modal coordinates ``eta`` of the massive beam mounts (kg^0.5 m,
+        unit modal mass; 0 at rest) and their rates (kg^0.5 m/s)
+        (:mod:`impstab.dynamics.beam_mounts`); None without massive beam mounts.
+    beam_mode_mounts : (n_modes,) int array or None
+        The mount of each kept mode.
+    beam_mode_omega : (n_modes,) array or None
+        The fixed-interface (hull and body end clamped) frequency of each kept mode (rad/s).
     """
 
     time: Array
@@ -82,6 +92,10 @@ class SimulationResult:
     tolerances: dict = field(default_factory=dict)
     internal_variables: Array | None = None
     internal_mounts: Array | None = None
+    beam_modes: Array | None = None
+    beam_mode_rates: Array | None = None
+    beam_mode_mounts: Array | None = None
+    beam_mode_omega: Array | None = None
 
     @property
     def displacement(self) -> Array:
@@ -136,6 +150,17 @@ class SimulationResult:
                                     {"units": "1", "long_name": "Prony term number"})
             coords_extra["term_mount"] = ("term", np.asarray(self.internal_mounts),
                                           {"units": "1", "long_name": "mount of each Prony term"})
+        if self.beam_modes is not None:
+            data["beam_modal_coordinate"] = (("time", "beam_mode"), self.beam_modes, {
+                "units": "kg^0.5 m", "long_name": "kept fixed-interface modal coordinate of a massive beam mount"})
+            data["beam_modal_rate"] = (("time", "beam_mode"), self.beam_mode_rates, {
+                "units": "kg^0.5 m/s", "long_name": "rate of the modal coordinate"})
+            coords_extra["beam_mode"] = ("beam_mode", np.arange(self.beam_modes.shape[1]),
+                                         {"units": "1", "long_name": "kept beam mode number"})
+            coords_extra["beam_mode_mount"] = ("beam_mode", np.asarray(self.beam_mode_mounts),
+                                               {"units": "1", "long_name": "mount of each kept beam mode"})
+            coords_extra["beam_mode_omega"] = ("beam_mode", np.asarray(self.beam_mode_omega), {
+                "units": "rad/s", "long_name": "fixed-interface frequency of each kept beam mode"})
         if self.error_estimate is not None:
             data["error_estimate"] = ("time", self.error_estimate, {
                 "units": "1", "long_name": "Hamming relative local error estimate (9/121)|p - c|"})
@@ -177,6 +202,9 @@ class SimulationResult:
                   tolerances=json.loads(a.get("tolerances", "{}")),
                   internal_variables=ds["internal_variable"].values if "internal_variable" in ds else None,
                   internal_mounts=ds["term_mount"].values if "term_mount" in ds.coords else None)
+        if "beam_modal_coordinate" in ds:
+            kw.update(beam_modes=ds["beam_modal_coordinate"].values, beam_mode_rates=ds["beam_modal_rate"].values,
+                      beam_mode_mounts=ds["beam_mode_mount"].values, beam_mode_omega=ds["beam_mode_omega"].values)
         return cls(**kw)
 
     def plot(self, ax=None):

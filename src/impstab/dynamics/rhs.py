@@ -26,7 +26,25 @@ with ``tau`` (body frame, moment about A) made of
   :mod:`impstab.linear.viscoelastic`;
 * the thrust ``T (eta_t R e + (1 - eta_t) e)`` at ``R r_T`` (follower part, fixed part);
 * the propeller gyroscopic moment ``-nu2 x h``, ``h = J_p Omega e`` (body frame);
-* the fluid radiation damping ``-D_A nu`` (zero for incompressible fluid loading).
+* the fluid radiation damping ``-D_A nu`` (zero for incompressible fluid loading);
+* massive beam mounts (:mod:`impstab.dynamics.beam_mounts`): the mount acts by its static tip
+  stiffness ``K_tip`` as above, and its inertia in Craig-Bampton form (:mod:`impstab.linear.mount_dofs`):
+  kept fixed-interface modes ``eta_b`` (unit modal mass, stiffness ``Omega_b^2``, no damping) are
+  states after the Prony internal variables (all ``eta``, then all ``eta'``). With the body-end
+  node acceleration ``a_b = R6 (T_b nu' + c_b)`` (hull frame), ``R6 = diag(R, R)``,
+  ``T_b = [[I, -S(r_b)], [0, I]]``, ``c_b = (w x v + w x (w x r_b), 0)`` (body frame),
+
+      eta_b'' = -Omega_b^2 eta_b - m_te,b^T a_b,
+      f_b = -(m_tt,b a_b + m_te,b eta_b'') = -N_b a_b + m_te,b Omega_b^2 eta_b,  N_b = m_tt,b - m_te,b m_te,b^T
+
+  is the inertia force of beam b on the body at its body end (hull frame, force and moment), and
+  the body's equation becomes ``(M + sum T_b^T R6^T N_b R6 T_b) nu' = tau - sum T_b^T R6^T
+  (N_b R6 c_b - m_te,b Omega_b^2 eta_b)``, solved per evaluation (6 x 6 elimination without
+  pivoting: the matrix is symmetric positive definite) instead of the product with ``M^-1``.
+  This conserves the beam's kinetic energy ``(V_b, eta_b')^T [[m_tt, m_te], [m_te^T, I]] (V_b,
+  eta_b') / 2`` plus ``Omega_b^2 eta_b^2 / 2``; at rest ``eta_b = 0`` and the statics are
+  unchanged. Linearized at an equilibrium it is the grown system of
+  :meth:`~impstab.linear.mount_dofs.MountDofs.augment` with the same kept modes.
 
 ``C_RB(nu) nu`` is evaluated as the Newton-Euler terms ``m (w x v + w x (w x r_G))`` and
 ``w x I_A w + m r_G x (w x v)``. The added-mass Coriolis term ``C_A(nu) nu`` is omitted: the
@@ -66,7 +84,7 @@ from ..kinematics.scalar import cos, sin
 from ..kinematics.so3 import _jinv_into, _log_so3_into
 from ..model.mount_law import law_gradient
 
-__all__ = ["rhs_into", "rhs_batch", "model_rhs", "mount_loads_series", "workspace", "PITCH_LIMIT",
+__all__ = ["rhs_into", "rhs_batch", "model_rhs", "beam_body", "mount_loads_series", "workspace", "PITCH_LIMIT",
            "KIND_MODEL", "KIND_LINEAR", "FLAG_ROTATION", "FLAG_LAW", "N_BODY"]
 
 #: default guard on the pitch angle (rad): the z-y-x Euler angles are singular at +-90 degrees
@@ -89,14 +107,18 @@ FLAG_ROTATION, FLAG_LAW = 1, 2
 #: states of the body; the internal variables of viscoelastic mounts follow them
 N_BODY = 12
 
-#: length of the vector workspace: rotation vector (3), then the deflection and its rate (12)
+#: length of the vector workspace: rotation vector (3), then the deflection and its rate (12);
+#: for massive beam mounts the 6 x 6 system of the body's acceleration (36 + 6), the body-end map
+#: ``G = R6 T_b`` (36) and a 6-vector
 WS = 15
+WS_A, WS_B, WS_G, WS_V = WS, WS + 36, WS + 42, WS + 78
+WS_BEAM = WS + 84
 
 
 @njit(cache=True, error_model="numpy")
 def workspace(z):
     """``(rot, jinv, ws)``: the workspace of :func:`model_rhs` for states of ``z``'s dtype."""
-    return np.zeros((3, 3), dtype=z.dtype), np.zeros((3, 3), dtype=z.dtype), np.zeros(WS, dtype=z.dtype)
+    return np.zeros((3, 3), dtype=z.dtype), np.zeros((3, 3), dtype=z.dtype), np.zeros(WS_BEAM, dtype=z.dtype)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -209,16 +231,125 @@ def _prony_load(i, kmat, vstart, vpar, yeq, z, d0, d1, d2, out):
     return f0, f1, f2
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _beam_map_into(rot, r0, r1, r2, ws):
+    """``G = R6 T(r) = [[R, -R S(r)], [0, R]]`` (body-frame ``nu`` -> hull-frame velocity of the
+    body-end node at arm ``r``) into ``ws[WS_G:WS_G + 36]``, row-major."""
+    for a in range(6):
+        for c in range(6):
+            ws[WS_G + 6 * a + c] = 0.0
+    for a in range(3):
+        ra0, ra1, ra2 = rot[a, 0], rot[a, 1], rot[a, 2]
+        for c in range(3):
+            ws[WS_G + 6 * a + c] = rot[a, c]
+            ws[WS_G + 6 * (a + 3) + c + 3] = rot[a, c]
+        # row a of -R S(r): -S(r) = [[0, r2, -r1], [-r2, 0, r0], [r1, -r0, 0]]
+        ws[WS_G + 6 * a + 3] = -ra1 * r2 + ra2 * r1
+        ws[WS_G + 6 * a + 4] = ra0 * r2 - ra2 * r0
+        ws[WS_G + 6 * a + 5] = -ra0 * r1 + ra1 * r0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _beam_bias(rot, p, q, r, wv0, wv1, wv2, r0, r1, r2):
+    """``R (w x v + w x (w x r))`` (hull frame): the body-end node's acceleration at ``nu' = 0``."""
+    c0, c1, c2 = _cross3(p, q, r, r0, r1, r2)
+    d0, d1, d2 = _cross3(p, q, r, c0, c1, c2)
+    return _rotate(rot, wv0 + d0, wv1 + d1, wv2 + d2)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def beam_body(bpos, bmat, bstart, bmode, mass6, s0, yeq, z, rot, p, q, r, u, v, w, tau0, tau1, tau2, tau3, tau4,
+              tau5, ws, out):
+    """Body acceleration ``nu'`` into ``out[6:12]`` and the rates of the beams' modal states into
+    ``out[s0:s0 + 2 n]`` for the generalized force ``tau`` (body frame, moment about A) of
+    everything but the beams' inertia (:mod:`impstab.dynamics.rhs`, massive beam mounts).
+
+    ``bpos (nb, 3)`` arms, ``bmat (nb, 6, 6)`` ``N_b = m_tt - m_te m_te^T`` (hull frame),
+    ``bstart (nb + 1,)`` the modes of beam b are ``bstart[b]:bstart[b + 1]``, ``bmode (n, 7)``
+    per mode ``(Omega^2, m_te column)``, ``mass6`` the body's ``M_RB + M_A``; the states are
+    ``eta = y[s0:s0 + n]``, ``eta' = y[s0 + n:s0 + 2 n]``.
+    """
+    n = bmode.shape[0]
+    for a in range(6):
+        for c in range(6):
+            ws[WS_A + 6 * a + c] = mass6[a, c]
+    ws[WS_B], ws[WS_B + 1], ws[WS_B + 2] = tau0, tau1, tau2
+    ws[WS_B + 3], ws[WS_B + 4], ws[WS_B + 5] = tau3, tau4, tau5
+    wv0, wv1, wv2 = _cross3(p, q, r, u, v, w)
+    for b in range(bpos.shape[0]):
+        r0, r1, r2 = bpos[b, 0], bpos[b, 1], bpos[b, 2]
+        _beam_map_into(rot, r0, r1, r2, ws)
+        ch0, ch1, ch2 = _beam_bias(rot, p, q, r, wv0, wv1, wv2, r0, r1, r2)
+        # y = -N (R6 c) + m_te Omega^2 eta (hull frame), then tau += G^T y
+        for a in range(6):
+            ws[WS_V + a] = -(bmat[b, a, 0] * ch0 + bmat[b, a, 1] * ch1 + bmat[b, a, 2] * ch2)
+        for j in range(bstart[b], bstart[b + 1]):
+            k = bmode[j, 0] * (yeq[s0 + j] + z[s0 + j])
+            for a in range(6):
+                ws[WS_V + a] += bmode[j, 1 + a] * k
+        for a in range(6):
+            acc = 0.0 * ws[WS_V]
+            for c in range(6):
+                acc += ws[WS_G + 6 * c + a] * ws[WS_V + c]
+            ws[WS_B + a] += acc
+        # mass: A += G^T N G, column by column (N G e_c into ws[WS_V:])
+        for c in range(6):
+            for a in range(6):
+                acc = 0.0 * ws[WS_V]
+                for k in range(6):
+                    acc += bmat[b, a, k] * ws[WS_G + 6 * k + c]
+                ws[WS_V + a] = acc
+            for a in range(6):
+                acc = 0.0 * ws[WS_V]
+                for k in range(6):
+                    acc += ws[WS_G + 6 * k + a] * ws[WS_V + k]
+                ws[WS_A + 6 * a + c] += acc
+    # A nu' = tau: elimination without pivoting (A symmetric positive definite), nu' into out[6:12]
+    for k in range(6):
+        piv = ws[WS_A + 7 * k]
+        for i in range(k + 1, 6):
+            f = ws[WS_A + 6 * i + k] / piv
+            for j in range(k + 1, 6):
+                ws[WS_A + 6 * i + j] -= f * ws[WS_A + 6 * k + j]
+            ws[WS_B + i] -= f * ws[WS_B + k]
+    for i in range(5, -1, -1):
+        acc = ws[WS_B + i]
+        for j in range(i + 1, 6):
+            acc -= ws[WS_A + 6 * i + j] * out[6 + j]
+        out[6 + i] = acc / ws[WS_A + 7 * i]
+    # modes: eta'' = -Omega^2 eta - m_te^T a, a = G nu' + R6 c
+    for b in range(bpos.shape[0]):
+        r0, r1, r2 = bpos[b, 0], bpos[b, 1], bpos[b, 2]
+        _beam_map_into(rot, r0, r1, r2, ws)
+        ch0, ch1, ch2 = _beam_bias(rot, p, q, r, wv0, wv1, wv2, r0, r1, r2)
+        for a in range(6):
+            acc = 0.0 * ws[WS_V]
+            for c in range(6):
+                acc += ws[WS_G + 6 * a + c] * out[6 + c]
+            ws[WS_V + a] = acc
+        ws[WS_V] += ch0
+        ws[WS_V + 1] += ch1
+        ws[WS_V + 2] += ch2
+        for j in range(bstart[b], bstart[b + 1]):
+            acc = -bmode[j, 0] * (yeq[s0 + j] + z[s0 + j])
+            for a in range(6):
+                acc -= bmode[j, 1 + a] * ws[WS_V + a]
+            out[s0 + j] = yeq[s0 + n + j] + z[s0 + n + j]
+            out[s0 + n + j] = acc
+
+
 @njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, yeq, z, thrust, spin, out, rot, jinv,
-              ws):
+def model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, bpos, bmat, bstart, bmode, mass6, yeq, z,
+              thrust, spin, out, rot, jinv, ws):
     """``out = z'`` of the propulsor model at deviation ``z`` (thrust ``thrust`` N, spin
     ``spin`` rad/s), allocation-free: ``rot``, ``jinv`` and ``ws`` are the workspace of
     :func:`workspace` (of ``z``'s dtype; real or complex).
 
     ``vstart (n_mounts + 1,)``: the Prony terms of mount i are ``vstart[i]:vstart[i + 1]``;
     ``vpar (n_terms, 2)``: their weight ``g`` and relaxation time ``tau`` (s); their internal
-    variables are the states ``12 + 3 j : 15 + 3 j``.
+    variables are the states ``12 + 3 j : 15 + 3 j``. ``bpos, bmat, bstart, bmode, mass6``: the
+    massive beam mounts (:func:`beam_body`; no rows without them), their modal states after the
+    internal variables.
 
     Returns a status: 0, or 2 when ``|Re theta|`` reached the pitch guard (the derivative is
     still computed unless ``cos(theta)`` vanishes).
@@ -318,6 +449,10 @@ def model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, yeq,
         tau3 -= ws[6]
         tau4 -= ws[7]
         tau5 -= ws[8]
+    if bpos.shape[0] > 0:
+        beam_body(bpos, bmat, bstart, bmode, mass6, N_BODY + 3 * vpar.shape[0], yeq, z, rot, p, q, r, u, v, w,
+                  tau0, tau1, tau2, tau3, tau4, tau5, ws, out)
+        return status
     for a in range(6):
         s = minv[a, 0] * tau0
         s += minv[a, 1] * tau1
@@ -352,7 +487,8 @@ def rhs_into(kind, arrays, yeq, z, thrust, spin, out):
         return linear_rhs(arrays[8], z, out)
     rot, jinv, ws = workspace(z)
     return model_rhs(arrays[0], arrays[1], arrays[2], arrays[3], arrays[4], arrays[9], arrays[10], arrays[5],
-                     arrays[6], arrays[7], yeq, z, thrust, spin, out, rot, jinv, ws)
+                     arrays[6], arrays[7], arrays[11], arrays[12], arrays[13], arrays[14], arrays[15], yeq, z, thrust,
+                     spin, out, rot, jinv, ws)
 
 
 @njit(cache=True, error_model="numpy", compile_first=True)
@@ -365,19 +501,22 @@ def rhs_batch(kind, arrays, yeq, zs, thrust, spin, out, status):
     pos, kmat, cmat, flags, laws = arrays[0], arrays[1], arrays[2], arrays[3], arrays[4]
     par, minv, damp6, amat = arrays[5], arrays[6], arrays[7], arrays[8]
     vstart, vpar = arrays[9], arrays[10]
+    bpos, bmat, bstart, bmode, mass6 = arrays[11], arrays[12], arrays[13], arrays[14], arrays[15]
     for k in range(zs.shape[0]):
         if kind == KIND_LINEAR:
             status[k] = linear_rhs(amat, zs[k], out[k])
         else:
-            status[k] = model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, yeq, zs[k], thrust,
-                                  spin, out[k], rot, jinv, ws)
+            status[k] = model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, bpos, bmat, bstart,
+                                  bmode, mass6, yeq, zs[k], thrust, spin, out[k], rot, jinv, ws)
 
 
 @njit(cache=True, error_model="numpy", compile_first=True)
 def mount_loads_series(arrays, yeq, zs, out):
     """Mount forces (hull frame, N) and mount moments (N m) on the body for each state row of
     ``zs``, the Prony terms of viscoelastic mounts included; ``out`` has shape
-    ``(n_samples, n_mounts, 6)``."""
+    ``(n_samples, n_mounts, 6)``. A massive beam mount's load is that of its static tip stiffness
+    (and dampers) at the body-end deflection, without the beam's inertia force
+    (:mod:`impstab.dynamics.beam_mounts`)."""
     pos, kmat, cmat, flags, laws, par = arrays[0], arrays[1], arrays[2], arrays[3], arrays[4], arrays[5]
     vstart, vpar = arrays[9], arrays[10]
     rot, jinv, ws = workspace(yeq)

@@ -19,6 +19,7 @@ from .loading import Perturbation, as_thrust_history
 from .rhs import N_BODY, PITCH_LIMIT
 from .system import pack_dynamics
 from .result import SimulationResult
+from .beam_mounts import beam_dofs, check_beam_step, fastest_root
 from .viscoelastic import augmented_roots, check_explicit_step, step_limit
 
 __all__ = ["simulate", "check_work", "check_step", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
@@ -79,11 +80,21 @@ def fastest_mode(lin, model: Model | None = None) -> tuple[float, str]:
     return omega, mode
 
 
+def _has_beams(model: Model) -> bool:
+    return any(m.is_massive_beam for m in model.mounts)
+
+
 def _fastest(model: Model, lin) -> tuple[float, str, float]:
     """``(omega (rad/s), dominant dof, rate (1/s))``: the fastest mode of ``lin`` (snubbers in
-    contact included, :func:`fastest_mode`) and, with viscoelastic mounts, of the augmented
-    system with their internal variables, and its fastest real relaxation root (0 without)."""
+    contact included, :func:`fastest_mode`), with massive beam mounts of the body with the
+    beams' kept modes (:func:`~impstab.dynamics.beam_mounts.fastest_root`), and, with
+    viscoelastic mounts, of the augmented system with their internal variables, and its fastest
+    real relaxation root (0 without)."""
     omega, mode = fastest_mode(lin, model)
+    if _has_beams(model):
+        beam = fastest_root(model, lin.thrust)
+        if beam.omega > omega:
+            omega, mode = beam.omega, beam.mode
     if not model.is_viscoelastic:
         return omega, mode, 0.0
     roots = augmented_roots(model, lin.thrust)
@@ -95,7 +106,8 @@ def _fastest(model: Model, lin) -> tuple[float, str, float]:
 def default_step(model: Model, thrust: float) -> float:
     """Default fixed step (s) at constant thrust ``thrust`` (N): ``STEPS_PER_PERIOD`` per period of
     the fastest mode of the system linearized at the static equilibrium (with its snubbers in
-    full contact, when it has any) and per ``2 pi / rate`` of the fastest relaxation of the
+    full contact, when it has any; with the kept modes of massive beam mounts,
+    :mod:`impstab.dynamics.beam_mounts`) and per ``2 pi / rate`` of the fastest relaxation of the
     viscoelastic internal variables (:mod:`impstab.dynamics.viscoelastic`)."""
     omega, _, rate = _fastest(model, linearize(model, float(thrust), "equilibrium"))
     return step_limit(omega, rate, STEPS_PER_PERIOD)
@@ -110,12 +122,19 @@ def _spin_law(model: Model) -> Callable:
 
 def check_step(model: Model, thrust: float, integrator: str, dt: float | None, names: dict[str, str] | None = None) -> None:
     """Refuse a fixed step ``dt`` (s) of ``hamming`` or ``gill`` beyond its stability limit on the
-    relaxation of viscoelastic internal variables at constant thrust ``thrust`` (N), before a run
-    (:func:`~impstab.dynamics.viscoelastic.check_explicit_step`); ``names`` as :func:`check_work`."""
-    if dt is None or not model.is_viscoelastic or not get_integrator(integrator).fixed_step:
+    relaxation of viscoelastic internal variables or on the fastest kept mode of massive beam
+    mounts at constant thrust ``thrust`` (N), before a run
+    (:func:`~impstab.dynamics.viscoelastic.check_explicit_step`,
+    :func:`~impstab.dynamics.beam_mounts.check_beam_step`); ``names`` as :func:`check_work`."""
+    beams = _has_beams(model)
+    if dt is None or not (model.is_viscoelastic or beams) or not get_integrator(integrator).fixed_step:
         return
-    _, _, rate = _fastest(model, linearize(model, float(thrust), "equilibrium"))
-    check_explicit_step(model, str(integrator).lower(), float(dt), rate, (names or PYTHON_NAMES)["dt"])
+    name = get_integrator(integrator).name
+    omega, _, rate = _fastest(model, linearize(model, float(thrust), "equilibrium"))
+    field = (names or PYTHON_NAMES)["dt"]
+    check_explicit_step(model, name, float(dt), rate, field)
+    if beams:
+        check_beam_step(model, name, float(dt), omega, field)
 
 
 #: the argument names of :func:`simulate` in the messages of :func:`check_work`
@@ -132,7 +151,8 @@ def check_work(model: Model, step_sizes: list[float], duration: float, dt: float
     :data:`~impstab.limits.MAX_STEPS` (``allow_long``: :data:`~impstab.limits.LONG_FACTOR` times
     more). The samples of a run are every step, at most :data:`MAX_SAMPLES` of them, unless
     ``sample`` is given; each takes 8 bytes for the time, the 12 states, the thrust, the error
-    estimate, the 6 loads of every mount and the viscoelastic internal variables, twice (the run and a file written from it); they may
+    estimate, the 6 loads of every mount, the viscoelastic internal variables and the beam mounts' modal
+    states, twice (the run and a file written from it); they may
     take at most :data:`~impstab.limits.MAX_OUTPUT_BYTES`. ``names`` gives the argument names the
     messages use (``dt``, ``duration``, ``sample``, ``allow_long``).
     """
@@ -147,6 +167,8 @@ def check_work(model: Model, step_sizes: list[float], duration: float, dt: float
         raise ModelError(field, dt if dt is not None else duration,
                          f"would need {describe_count(total)} time steps (limit {describe_count(limit)}){hint}")
     internal = 3 * sum(m.viscoelastic.n_terms for m in model.mounts if m.viscoelastic is not None)
+    if _has_beams(model):
+        internal += 2 * beam_dofs(model).n
     per_sample = 8 * 2 * (15 + 6 * len(model.mounts) + internal)
     samples = sum(math.ceil(duration / sample) if sample is not None else min(math.ceil(duration / h), MAX_SAMPLES)
                   for h in step_sizes)
@@ -175,7 +197,9 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
     integrator : {"hamming", "gill", "dop853", "rk45", "radau", "lsoda"}
     dt : float, optional
         Fixed step (s) of ``hamming`` and ``gill``; default: ``STEPS_PER_PERIOD`` steps per period of
-        the fastest mode of the linearized system. A larger step warns (:class:`StepSizeWarning`).
+        the fastest mode of the linearized system (the kept modes of massive beam mounts included).
+        A larger step warns (:class:`StepSizeWarning`); one beyond the method's stability limit on
+        a viscoelastic relaxation or a kept beam mode is refused (:class:`~impstab.errors.ModelError`).
         For the SciPy methods it is the largest step (default unlimited). The step is shortened
         slightly so that samples and the end of the run fall on steps.
     perturbation : Perturbation, dict or None
@@ -231,7 +255,8 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
     yeq = np.zeros(system.n_states)
     yeq[:3] = lin.displacement
     yeq[3:6] = matrix_to_euler_zyx(lin.rotation)
-    # viscoelastic internal variables at rest: w_ij = d_i (the static deflection carries the load)
+    # internal states at rest: viscoelastic w_ij = d_i (the static deflection carries the load),
+    # beam modes eta = eta' = 0 (the constraint modes carry the statics)
     yeq[N_BODY:] = system.internal_equilibrium(lin.displacement, lin.rotation)
     z0 = np.zeros(system.n_states)
     z0[:N_BODY] = pert.vector
@@ -252,6 +277,8 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
     h_limit = step_limit(omega, rate, STEPS_PER_PERIOD)
     if solver.fixed_step and dt is not None:
         check_explicit_step(model, solver.name, dt, rate)
+        if system.n_modes:
+            check_beam_step(model, solver.name, dt, omega)
         if dt > h_limit * (1 + 1e-9):
             what = (f"the fastest mode ({mode}, {omega / (2 * math.pi):.4g} Hz)" if omega >= rate else
                     f"the fastest relaxation of the viscoelastic internal variables ({rate:.4g} 1/s)")
@@ -274,9 +301,11 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
         tt = np.asarray(history(t), dtype=float)
         return np.vstack([tt, spin(tt)])
 
-    # error weights make every state a length; the internal variables are lengths (m)
-    weights = np.array([1, 1, 1, length, length, length] + [1 / omega] * 3 + [length / omega] * 3
-                       + [1.0] * (system.n_states - N_BODY))
+    # error weights make every state a length; the internal variables are lengths (m), a beam's
+    # modal coordinate (kg^0.5 m) over the square root of the beam's mass is one
+    root_mass = np.sqrt([model.mounts[i].beam.mass for i in system.mode_mounts])
+    weights = np.concatenate([[1, 1, 1, length, length, length], [1 / omega] * 3, [length / omega] * 3,
+                              np.ones(3 * system.n_terms), 1 / root_mass, 1 / (root_mass * omega)])
     # absolute tolerance (in metres after weighting): rtol x the initial deviation, floored at
     # 1e-15 x the length scale, where the rounding of the absolute state (eps x |y_eq|) takes over
     scale = max(float(np.max(np.abs(weights * z0))), 1e-9 * length)
@@ -317,12 +346,17 @@ def _assemble(model, history, solver, problem, raw, lin, yeq, length, omega, mod
         offset[3:6] = np.asarray(matrix_to_euler_zyx(lin_end.rotation)) - yeq[3:6]
     if lin_end is not None and model.is_viscoelastic:
         linear_rate = augmented_roots(model, lin_end.thrust).max_real
+    elif lin_end is not None and problem.system.n_modes:
+        linear_rate = fastest_root(model, lin_end.thrust).max_real
     body = raw.z[:, :N_BODY]
     growth = fit_run(raw.time, body, length, fit_window, linear_rate, t_end, omega_max=omega, offset=offset,
                      thrusts=thrust_t)
     internal = None
-    if raw.z.shape[1] > N_BODY:
-        internal = (yeq[None, N_BODY:] + raw.z[:, N_BODY:]).reshape(raw.z.shape[0], -1, 3)
+    sysm = problem.system
+    start, n_modes = sysm.mode_start, sysm.n_modes
+    if sysm.n_terms:
+        internal = (yeq[None, N_BODY:start] + raw.z[:, N_BODY:start]).reshape(raw.z.shape[0], -1, 3)
+    modal = None if not n_modes else raw.z[:, start:start + 2 * n_modes]
     crit = None
     classification = "not computed"
     if critical_thrust is not False:
@@ -349,4 +383,8 @@ def _assemble(model, history, solver, problem, raw, lin, yeq, length, omega, mod
         tolerances={"tol": problem.tol, "rtol": problem.rtol} if not solver.fixed_step or problem.tol else {},
         internal_variables=internal,
         internal_mounts=None if internal is None else problem.system.term_mounts.copy(),
+        beam_modes=None if modal is None else np.ascontiguousarray(modal[:, :n_modes]),
+        beam_mode_rates=None if modal is None else np.ascontiguousarray(modal[:, n_modes:]),
+        beam_mode_mounts=None if modal is None else sysm.mode_mounts.copy(),
+        beam_mode_omega=None if modal is None else np.sqrt(np.asarray(sysm.arrays[14])[:, 0]),
     )

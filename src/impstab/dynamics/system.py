@@ -33,9 +33,10 @@ class DynamicSystem:
     """A system packed for the compiled kernels.
 
     ``kind = 0``: the propulsor model (12 states, then 3 per Prony term of its viscoelastic
-    mounts); ``kind = 1``: a linear system ``z' = A z`` (used to test the integrators on
-    oscillators). ``arrays`` is the tuple handed to the kernels; ``length_scale`` (m) is the
-    model's largest mount or thrust arm.
+    mounts, then the kept modal coordinates ``eta`` of its massive beam mounts and their rates
+    ``eta'``, :mod:`impstab.dynamics.beam_mounts`); ``kind = 1``: a linear system ``z' = A z``
+    (used to test the integrators on oscillators). ``arrays`` is the tuple handed to the kernels;
+    ``length_scale`` (m) is the model's largest mount or thrust arm.
     """
 
     kind: int
@@ -55,21 +56,37 @@ class DynamicSystem:
         start = np.asarray(self.arrays[9])
         return np.repeat(np.arange(start.size - 1), np.diff(start))
 
+    @property
+    def n_modes(self) -> int:
+        """Number of kept modes of massive beam mounts (states ``eta`` then ``eta'``, ``2 n_modes``)."""
+        return int(self.arrays[14].shape[0])
+
+    @property
+    def mode_start(self) -> int:
+        """First state of the beams' modal coordinates: ``12 + 3 n_terms``."""
+        return 12 + 3 * self.n_terms
+
+    @property
+    def mode_mounts(self) -> NDArray[np.int64]:
+        """The mount of each kept beam mode (index into the model's mounts)."""
+        flags = np.asarray(self.arrays[16], dtype=np.int64)
+        return np.repeat(flags, np.diff(np.asarray(self.arrays[13])))
+
     def internal_equilibrium(self, displacement, rotation) -> NDArray[np.float64]:
-        """The internal variables at rest ``w_ij = d_i`` (``(3 n_terms,)``, m, hull frame) for the
-        body at ``displacement`` (m) and ``rotation`` (3 x 3, body -> hull)."""
+        """The internal states at rest for the body at ``displacement`` (m) and ``rotation``
+        (3 x 3, body -> hull): the Prony terms' ``w_ij = d_i`` (``3 n_terms``, m, hull frame),
+        then ``eta = eta' = 0`` of the beams' modes (``2 n_modes``)."""
         pos = np.asarray(self.arrays[0])[self.term_mounts]
         d = np.asarray(displacement, float)[None] + pos @ np.asarray(rotation, float).T - pos
-        return d.reshape(-1)
+        return np.concatenate([d.reshape(-1), np.zeros(2 * self.n_modes)])
 
 
 def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
-    """Pack ``model`` for the kernels: mounts, mass properties, thrust line, propeller, and the
-    Prony terms of viscoelastic mounts (:attr:`~impstab.model.mounts.Mount.viscoelastic`)."""
+    """Pack ``model`` for the kernels: mounts, mass properties, thrust line, propeller, the
+    Prony terms of viscoelastic mounts (:attr:`~impstab.model.mounts.Mount.viscoelastic`) and the
+    kept modes of massive beam mounts (:mod:`impstab.dynamics.beam_mounts`)."""
     from ..linear.linearize import pack_model
-    from ..linear.mount_dofs import refuse_massive_beams
-
-    refuse_massive_beams(model, "the nonlinear time histories (simulate, postcritical)")
+    from .beam_mounts import beam_dofs, pack_beams
 
     pk = pack_model(model)
     nm = pk.positions.shape[0]
@@ -102,16 +119,22 @@ def pack_dynamics(model, pitch_limit: float = PITCH_LIMIT) -> DynamicSystem:
         np.ascontiguousarray(np.linalg.inv(pk.mass6)), np.ascontiguousarray(pk.damp6), np.zeros((1, 1)),
         vstart, np.ascontiguousarray(np.array(vpar, dtype=float).reshape(-1, 2)),
     )
-    return DynamicSystem(KIND_MODEL, arrays, N_BODY + 3 * len(vpar), nm, float(pk.length_scale))
+    dofs = beam_dofs(model)
+    beams = np.array([i for i, m in enumerate(model.mounts) if m.is_massive_beam], dtype=np.int64)
+    arrays = arrays + pack_beams(dofs, pk.mass6) + (beams,)
+    n_modes = 0 if dofs is None else dofs.n
+    return DynamicSystem(KIND_MODEL, arrays, N_BODY + 3 * len(vpar) + 2 * n_modes, nm, float(pk.length_scale))
 
 
 def linear_dynamics(amat) -> DynamicSystem:
     """A linear system ``z' = A z`` for the same kernels (oscillator tests of the integrators)."""
+    from .beam_mounts import no_beams
+
     amat = np.ascontiguousarray(amat, dtype=float)
     n = amat.shape[0]
     arrays = (np.zeros((0, 3)), np.zeros((0, 6, 6)), np.zeros((0, 6, 6)), np.zeros(0, dtype=np.int64),
               np.zeros((0, N_LAW)), np.zeros(N_PAR), np.zeros((6, 6)), np.zeros((6, 6)), amat,
-              np.zeros(1, dtype=np.int64), np.zeros((0, 2)))
+              np.zeros(1, dtype=np.int64), np.zeros((0, 2))) + no_beams(np.eye(6)) + (np.zeros(0, dtype=np.int64),)
     return DynamicSystem(KIND_LINEAR, arrays, n, 0)
 
 
@@ -147,8 +170,10 @@ class NonlinearSystem:
     ``T`` (N) is the parameter; the propeller spin follows the model's speed law unless given.
 
     With viscoelastic mounts the state goes on with the internal variables ``w_ij`` of their
-    Prony terms (3 each, hull frame, m; :mod:`impstab.dynamics.viscoelastic`): ``n_states`` is
-    ``12 + 3 n_terms``; at an equilibrium ``w_ij = d_i``.
+    Prony terms (3 each, hull frame, m; :mod:`impstab.dynamics.viscoelastic`), then with massive
+    beam mounts the kept modal coordinates ``eta`` (kg^0.5 m) and their rates ``eta'``
+    (:mod:`impstab.dynamics.beam_mounts`): ``n_states`` is ``12 + 3 n_terms + 2 n_modes``; at an
+    equilibrium ``w_ij = d_i`` and ``eta = eta' = 0``.
 
     Every evaluation runs the compiled right-hand side of the simulation (one implementation),
     on real or complex128 states: the code is analytic in the state, so ``f`` of a complex state
@@ -181,7 +206,7 @@ class NonlinearSystem:
 
     @property
     def n_states(self) -> int:
-        """12, and 3 per Prony term of the viscoelastic mounts."""
+        """12, 3 per Prony term of the viscoelastic mounts and 2 per kept beam mode."""
         return self.system.n_states
 
     def spin(self, thrust: float) -> float:
@@ -190,7 +215,7 @@ class NonlinearSystem:
 
     def equilibrium(self, thrust: float) -> NDArray[np.float64]:
         """The static equilibrium state at thrust ``thrust`` (N): ``(X_A, Xi, 0)`` (12,), then the
-        internal variables at rest (``w_ij = d_i``); the continuation and Newton method of the
+        internal states at rest (``w_ij = d_i``, ``eta = eta' = 0``); the continuation and Newton method of the
         linear analyses (:func:`equilibrium_state`)."""
         y, lin = equilibrium_state(self.model, thrust)
         return np.concatenate([y, self.system.internal_equilibrium(lin.displacement, lin.rotation)])

@@ -179,6 +179,11 @@ class ModelFamily:
         :meth:`affine_parts` return the grown system (:meth:`evaluate` stays the 6-dof body
         system with each mount as its static stiffness). False, or a model without massive beam
         mounts: ``n = 6``.
+    cutoff : float
+        With ``mount_dofs``: keep the beams' fixed-interface modes below ``cutoff`` times the body's
+        highest frequency (:func:`~impstab.linear.mount_dofs.mount_dofs`; default
+        :data:`~impstab.linear.mount_dofs.CUTOFF`, the time histories use
+        :data:`~impstab.dynamics.beam_mounts.SIM_CUTOFF`).
     """
 
     model: Model
@@ -186,6 +191,7 @@ class ModelFamily:
     damped: bool = True
     fluid_frequency: float = 0.0
     mount_dofs: bool = True
+    cutoff: float | None = None
 
     def __post_init__(self) -> None:
         lin = self.linearization or self.model.analysis.linearization
@@ -196,9 +202,10 @@ class ModelFamily:
         object.__setattr__(self, "_packed", pk)
         object.__setattr__(self, "_affine", self._affine_form(pk, lin))
         # -- massive beam mounts: internal dofs (impstab.linear.mount_dofs) --
-        from .mount_dofs import mount_dofs
+        from .mount_dofs import CUTOFF, mount_dofs
 
-        object.__setattr__(self, "_internal", mount_dofs(self.model) if self.mount_dofs else None)
+        cutoff = CUTOFF if self.cutoff is None else float(self.cutoff)
+        object.__setattr__(self, "_internal", mount_dofs(self.model, cutoff=cutoff) if self.mount_dofs else None)
 
     @staticmethod
     def _affine_form(pk: PackedModel, lin: str):

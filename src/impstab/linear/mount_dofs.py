@@ -35,11 +35,10 @@ import numpy as np
 import scipy.linalg as sla
 from numpy.typing import NDArray
 
-from ..errors import ModelError
 from ..kinematics import rigid_map6
 from ..model.beam import internal_matrices
 
-__all__ = ["MountDofs", "mount_dofs", "refuse_massive_beams"]
+__all__ = ["MountDofs", "mount_dofs"]
 
 Array = NDArray[np.float64]
 
@@ -172,12 +171,3 @@ def mount_dofs(model, elements: int | None = None, cutoff: float = CUTOFF) -> Mo
     return MountDofs(positions=positions, m_tt=np.array([p[0] for p in parts]), m_te=tuple(m_te),
                      omega2=np.concatenate(omega2), offsets=tuple(offsets), dropped=dropped, cutoff=limit)
 
-
-def refuse_massive_beams(model, what: str) -> None:
-    """One-line :class:`~impstab.errors.ModelError` when ``model`` has a beam mount with mass and the
-    analysis ``what`` does not carry the mount's internal dofs."""
-    for i, mt in enumerate(model.mounts):
-        if mt.is_massive_beam:
-            raise ModelError(f"mounts[{i}].beam.density", mt.beam.density,
-                             f"{what} does not support beam mounts with mass (internal dofs) yet: "
-                             "use `impstab critical`, or density = 0 for the massless beam")

@@ -111,7 +111,8 @@ MODEL_REFERENCE: dict[str, E] = {
     "mounts[].beam": E("", "A Timoshenko beam along the mount axis, instead of k_axial/k_shear or stiffness: hull end "
                        "clamped at position - length * axis, body end at position. Massless, it is exactly the 6 x 6 "
                        "stiffness K_tip (inverse of its clamped-free tip flexibility); with density > 0 its finite "
-                       "elements add internal dofs to the stability analysis (docs/mounts.md)."),
+                       "elements add internal dofs to the stability analysis and their first modes to the time histories "
+                       "(docs/mounts.md)."),
     "mounts[].beam.length": E("m", "Free length L of the beam, from the clamped hull end to the body end.",
                               "beam length"),
     "mounts[].beam.outer_diameter": E("m", "Outer diameter of the circular section.", "beam outer diameter"),

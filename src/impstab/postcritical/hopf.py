@@ -77,8 +77,12 @@ L1_ZERO_FACTOR = 1.0
 #: or seam nearer than the radius), and the smallest bound is kept
 L1_TARGET = 1e-6
 RADIUS_LADDER = (1.0, 4.0, 0.25, 1.0 / 16.0)
-#: Newton refinement of the onset: |Re lambda| below this share of |lambda|
+#: Newton refinement of the onset: |Re lambda| below this share of |lambda|, or below
+#: ONSET_RESOLUTION x eps x ||J||_F, the rounding of an eigenvalue of the pencil (QZ is backward
+#: stable to eps ||J||): a state with stiff modes (the kept modes of massive beam mounts) has a
+#: norm thousands of times its onset frequency
 ONSET_TOLERANCE = 1e-13
+ONSET_RESOLUTION = 4.0
 ONSET_ITERATIONS = 40
 
 
@@ -324,8 +328,8 @@ def hopf_analysis(
         p, x, lam, iterations, refined = _refine(system, x, p, lam, bracket)
     hopf = _analyse(system, x, p, lam, iterations, refined, radius, points, check)
     if refine and not refined:
-        note = (f"the onset was not refined to |Re lambda| <= {ONSET_TOLERANCE:g} |lambda| in {iterations} Newton "
-                f"steps (Re lambda = {hopf.eigenvalue.real:.3g})")
+        note = (f"the onset was not refined to |Re lambda| <= {ONSET_TOLERANCE:g} |lambda| (or its rounding) in "
+                f"{iterations} Newton steps (Re lambda = {hopf.eigenvalue.real:.3g})")
         hopf = replace(hopf, warnings=hopf.warnings + (note,))
     return hopf
 
@@ -381,7 +385,8 @@ def _refine(system, x, p, lam, bracket):
         spec = spectrum(jac, system.mass)
         idx = spec.nearest(lam, upper=True)
         lam = complex(spec.eigenvalues[idx])
-        if abs(lam.real) <= ONSET_TOLERANCE * max(abs(lam), 1e-300):
+        resolution = ONSET_RESOLUTION * np.finfo(float).eps * float(np.linalg.norm(jac))
+        if abs(lam.real) <= max(ONSET_TOLERANCE * abs(lam), resolution, 1e-300):
             return p, x, lam, it - 1, True
         forms = Forms(system, x, p)
         dlam, x_p, _ = _eigen_derivative(system, forms, jac, spec, idx)
@@ -442,7 +447,7 @@ def _analyse(system, x, p, lam, iterations, refined, radius, points, check) -> H
         reason = ("divergence: a real eigenvalue crosses zero (a static instability, fold or pitchfork of "
                   "equilibria): no limit cycle is born")
     else:
-        reason, multiplicity = _degeneracy(jac, mass, spec, idx, lam, kappa, dlam, scale)
+        reason, multiplicity = _degeneracy(jac, mass, spec, idx, lam, kappa, dlam, scale, system.state_scale)
     base = dict(parameter=float(p), state=x, onset=onset, eigenvalue=lam,
                 omega=None if onset == "divergence" else abs(lam.imag),
                 spectrum=spec.eigenvalues, eigenvalue_condition=kappa, multiplicity=multiplicity,
@@ -542,9 +547,17 @@ def _near_eigenvalue_warning(spec: Spectrum, idx, lam, kappa, dlam, system: Dyna
             "the computed branch is reliable")
 
 
-def _degeneracy(jac, mass, spec: Spectrum, idx, lam, kappa, dlam, scale) -> tuple[str | None, int]:
-    """Why a pair at ``lam`` is not a plain Hopf point (None when it is), and the multiplicity."""
+def _degeneracy(jac, mass, spec: Spectrum, idx, lam, kappa, dlam, scale, states=None) -> tuple[str | None, int]:
+    """Why a pair at ``lam`` is not a plain Hopf point (None when it is), and the multiplicity.
+
+    The null directions of ``J - lam B`` are counted in the state scales ``states`` (the
+    similar pencil ``S^-1 (J, B) S``, ``S = diag(states)``: same eigenvalues, singular values of
+    states in their units of "small"; a state of kg^0.5 m beside one of rad would otherwise set
+    the rank test's scale)."""
     lam_all = spec.eigenvalues
+    if states is not None:
+        sc = np.asarray(states, dtype=float)
+        jac, mass = jac * sc[None, :] / sc[:, None], mass * sc[None, :] / sc[:, None]
     shifted = jac - lam * mass
     u, s, vh = sla.svd(shifted)
     null = int(np.sum(s <= NULL_TOLERANCE * s[0]))

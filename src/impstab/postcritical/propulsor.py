@@ -20,9 +20,11 @@ State scales (the unit of "small" of each state, which weighs the arclength and 
 circles): ``0.01 L`` for the position of A, ``0.01`` rad for the angles, and those times the
 onset frequency for the velocities, ``L`` the model's largest mount or thrust arm. Viscoelastic
 mounts add their internal variables to the state (:mod:`impstab.dynamics.viscoelastic`,
-``w{j}_x, w{j}_y, w{j}_z`` for Prony term j, scaled like the position of A); the cycles'
-amplitudes, profiles and mount peaks are those of the body's 12 states, the Floquet multipliers
-those of the whole state.
+``w{j}_x, w{j}_y, w{j}_z`` for Prony term j, scaled like the position of A); massive beam
+mounts add their kept modal coordinates and rates (:mod:`impstab.dynamics.beam_mounts`,
+``eta{j}`` and ``eta{j}_rate``, kg^0.5 m, scaled like the position of A times the square root of
+the beam's mass; 0 at the equilibrium); the cycles' amplitudes, profiles and mount peaks are those
+of the body's 12 states, the Floquet multipliers those of the whole state.
 """
 
 from __future__ import annotations
@@ -75,15 +77,20 @@ def propulsor_system(model, omega: float | None = None) -> tuple[DynamicalSystem
     w = float(omega) if omega else 1.0
     xs = DEFAULTS["relative_position_scale"] * length
     an = DEFAULTS["angle_scale"]
-    n_internal = ns.n_states - 12  # viscoelastic internal variables (m): scaled like the position of A
-    scale = np.array([xs] * 3 + [an] * 3 + [w * xs] * 3 + [w * an] * 3 + [xs] * n_internal)
-    names = STATE_NAMES + tuple(f"w{j}_{a}" for j in range(n_internal // 3) for a in "xyz")
+    n_internal = 3 * ns.system.n_terms  # viscoelastic internal variables (m): scaled like the position of A
+    n_modes = ns.system.n_modes         # beam modal coordinates (kg^0.5 m): the position scale x sqrt(beam mass)
+    root_mass = np.sqrt([model.mounts[i].beam.mass for i in ns.system.mode_mounts])
+    scale = np.concatenate([[xs] * 3 + [an] * 3 + [w * xs] * 3 + [w * an] * 3 + [xs] * n_internal,
+                            xs * root_mass, w * xs * root_mass])
+    names = (STATE_NAMES + tuple(f"w{j}_{a}" for j in range(n_internal // 3) for a in "xyz")
+             + tuple(f"eta{j}" for j in range(n_modes)) + tuple(f"eta{j}_rate" for j in range(n_modes)))
+    units = STATE_UNITS + ("m",) * n_internal + ("kg^0.5 m",) * n_modes + ("kg^0.5 m/s",) * n_modes
 
     def rhs(states, thrust):
         return ns.rhs(states, float(np.real(thrust)))
 
     system = DynamicalSystem(rhs, ns.n_states, vectorized=True, complex_parameter=False, state_names=names,
-                             state_units=STATE_UNITS + ("m",) * n_internal, parameter_name="thrust", parameter_units="N",
+                             state_units=units, parameter_name="thrust", parameter_units="N",
                              time_units="s", state_scale=scale, region=_regions(ns))
     return system, ns
 
