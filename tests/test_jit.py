@@ -22,7 +22,7 @@ CLOSED_FORM = 18012.0999227555
 
 
 def _python(code: str, **env: str) -> str:
-    environment = dict(os.environ, **env)
+    environment = dict(os.environ, **{"IMPSTAB_JIT": "auto", **env})  # the default policy unless given
     environment["PYTHONPATH"] = str(ROOT / "src") + os.pathsep + environment.get("PYTHONPATH", "")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=environment,
                           timeout=600, cwd=ROOT)

@@ -224,6 +224,9 @@ def test_precompile_stops_at_a_complete_cache_and_keeps_the_users_own(tmp_path, 
     (own / precompile.MARKER).write_text("done\n")
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(own))
     monkeypatch.delenv(_numba_cache.SET_BY_IMPSTAB, raising=False)
+    # precompile sets IMPSTAB_JIT = compiled for its worker processes: restored after the test (the
+    # later tests of this process and their subprocesses run under the default policy)
+    monkeypatch.setenv("IMPSTAB_JIT", "auto")
     assert precompile.main(["--quiet"]) == 0
     assert "already compiled" in capsys.readouterr().out
     assert precompile.main(["--clean"]) == 0
