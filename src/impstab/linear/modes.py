@@ -286,6 +286,9 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
     damping at its own frequency, iterated to consistency (fixed point on the frequency).
     """
     if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: the grown system
+        from .viscoelastic import refuse_massive_beams
+
+        refuse_massive_beams(model)
         grown = _grown_modes(model, thrust, linearization)
         if not model.fluid.compressible:
             return grown

@@ -36,7 +36,8 @@ from ..model.model import Model
 from ..model.viscoelastic import prony_ratio
 from .linearize import ModelFamily
 
-__all__ = ["ViscoelasticFamily", "ExactOnset", "exact_onset", "augmented_matrices", "dynamic_stiffness"]
+__all__ = ["ViscoelasticFamily", "ExactOnset", "exact_onset", "augmented_matrices", "dynamic_stiffness",
+           "refuse_massive_beams"]
 
 Array = NDArray[np.float64]
 
@@ -182,6 +183,22 @@ def _d_dynamic_stiffness(lam: complex, m, c, stiff: Array, model: Model, terms) 
     return f
 
 
+def refuse_massive_beams(model: Model) -> None:
+    """One-line :class:`~impstab.errors.ModelError` for a model with viscoelastic mounts and beam mounts
+    with mass: the augmented system of the internal variables is built on the body's 6 dofs and does
+    not carry the beams' internal dofs (it dropped the beams' inertia without a word)."""
+    if not model.is_viscoelastic:
+        return
+    for i, mt in enumerate(model.mounts):
+        if mt.is_massive_beam:
+            from ..errors import ModelError
+
+            raise ModelError(f"mounts[{i}].beam.density", mt.beam.density,
+                             "beam mounts with mass beside viscoelastic mounts in one model are not supported yet "
+                             "(the internal variables' augmented system does not carry the beams' internal dofs): "
+                             "use density = 0 for the massless beam")
+
+
 @dataclass(frozen=True, eq=False)
 class ViscoelasticFamily:
     """The model's augmented first-order family ``E x' = A(T) x`` (a :class:`FirstOrderFamily`).
@@ -206,6 +223,7 @@ class ViscoelasticFamily:
     n_dof = 6
 
     def __post_init__(self) -> None:
+        refuse_massive_beams(self.model)
         base = ModelFamily(self.model, self.linearization, damped=True, fluid_frequency=self.fluid_frequency)
         object.__setattr__(self, "base", base)
         object.__setattr__(self, "linearization", base.linearization)
