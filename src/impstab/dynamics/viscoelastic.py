@@ -78,7 +78,10 @@ def augmented_roots(model: Model, thrust: float) -> AugmentedRoots:
     ``thrust`` (N), sorted into oscillating roots and real (relaxation) roots."""
     from ..linear.viscoelastic import ViscoelasticFamily
 
-    e, a = ViscoelasticFamily(model, "equilibrium").matrices(np.array([float(thrust)]))
+    from .beam_mounts import SIM_CUTOFF
+
+    # massive beam mounts: their modes as the time histories keep them (beam_mounts.SIM_CUTOFF)
+    e, a = ViscoelasticFamily(model, "equilibrium", cutoff=SIM_CUTOFF).matrices(np.array([float(thrust)]))
     vals, vecs = np.linalg.eig(np.linalg.solve(e[0], a[0]))
     scale = max(float(np.abs(vals).max()), 1e-300)
     real = np.abs(vals.imag) <= 1e-9 * scale

@@ -302,7 +302,7 @@ def locus(
     if model.is_viscoelastic:  # internal variables: the augmented first-order system
         from .viscoelastic import ViscoelasticFamily, augmented_matrices
 
-        fam = ViscoelasticFamily(model, linearization, fluid_frequency=f_fluid)
+        fam = ViscoelasticFamily(model, linearization, fluid_frequency=f_fluid, cutoff=LOCUS_CUTOFF)
         m, c, k, rho = fam.system(thrusts)
         e, a = augmented_matrices(m, c, k, rho, fam.terms)  # type: ignore[attr-defined]
         good = np.isfinite(a).all(axis=(1, 2))

@@ -285,19 +285,16 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
     With compressible fluid loading each mode is computed with the added mass and radiation
     damping at its own frequency, iterated to consistency (fixed point on the frequency).
     """
-    if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: the grown system
-        from .viscoelastic import refuse_massive_beams
+    if model.is_viscoelastic:  # internal variables (and any massive beams' dofs): the augmented system
+        from .viscoelastic import viscoelastic_modes
 
-        refuse_massive_beams(model)
+        return viscoelastic_modes(model, thrust, linearization)
+    if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: the grown system
         grown = _grown_modes(model, thrust, linearization)
         if not model.fluid.compressible:
             return grown
         return _fluid_consistent(model, thrust, linearization, grown,
                                  lambda f: _grown_modes(model, thrust, linearization, f))
-    if model.is_viscoelastic:  # internal variables: the augmented first-order system
-        from .viscoelastic import viscoelastic_modes
-
-        return viscoelastic_modes(model, thrust, linearization)
     base = modes_of_system(linearize(model, thrust, linearization))
     if not model.fluid.compressible:
         return base

@@ -36,8 +36,7 @@ from ..model.model import Model
 from ..model.viscoelastic import prony_ratio
 from .linearize import ModelFamily
 
-__all__ = ["ViscoelasticFamily", "ExactOnset", "exact_onset", "augmented_matrices", "dynamic_stiffness",
-           "refuse_massive_beams"]
+__all__ = ["ViscoelasticFamily", "ExactOnset", "exact_onset", "augmented_matrices", "dynamic_stiffness"]
 
 Array = NDArray[np.float64]
 
@@ -92,9 +91,11 @@ def _reduced_ranks(maps: Array, terms) -> dict[float, int]:
 
 def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced: bool = False,
                        ranks: dict[float, int] | None = None, maps=None) -> tuple[Array, Array]:
-    """``E, A`` of the augmented state for stacks ``m, c = D + G, k (S, 6, 6)`` and arms ``rho (S, nm, 3)``.
+    """``E, A`` of the augmented state for stacks ``m, c = D + G, k (S, nq, nq)`` and arms ``rho (S, nm, 3)``.
 
-    ``terms`` as :func:`_terms` returns. Returns ``E, A (S, N, N)``, ``N = 12 + 3 sum n_i``.
+    ``terms`` as :func:`_terms` returns. Returns ``E, A (S, N, N)``, ``N = 2 nq + 3 sum n_i``. The
+    dofs are the body's 6 (``nq = 6``), or the body's followed by the internal dofs of massive beam
+    mounts (:mod:`impstab.linear.mount_dofs`): the mounts' maps act on the body's dofs only.
 
     ``reduced``: the internal variables that share a relaxation time ``tau`` obey one equation
     ``tau z' = B q - z`` (``B`` the mounts' maps stacked): only ``z`` in the range of ``B`` (rank
@@ -136,24 +137,26 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
             weights[j] = float(np.sum(g))
             for gj, tj in zip(g, tau):
                 blocks.append((maps[:, j], gj * btk[:, j], float(tj)))
-    kk = k + np.einsum("v,svab->sab", weights, stiff)
+    nq = m.shape[-1]  # 6, or 6 + the internal dofs of massive beam mounts (the body's dofs first)
+    kk = np.array(k, dtype=float)
+    kk[:, :6, :6] += np.einsum("v,svab->sab", weights, stiff)
     nz = sum(blk[0].shape[1] for blk in blocks)
-    n = 12 + nz
+    n = 2 * nq + nz
     e = np.zeros((s, n, n))
     a = np.zeros((s, n, n))
-    e[:, :6, :6] = np.eye(6)
-    e[:, 6:12, 6:12] = m
-    e[:, 12:, 12:] = np.eye(nz)
-    a[:, :6, 6:12] = np.eye(6)
-    a[:, 6:12, 6:12] = -c
-    row = 12
+    e[:, :nq, :nq] = np.eye(nq)
+    e[:, nq:2 * nq, nq:2 * nq] = m
+    e[:, 2 * nq:, 2 * nq:] = np.eye(nz)
+    a[:, :nq, nq:2 * nq] = np.eye(nq)
+    a[:, nq:2 * nq, nq:2 * nq] = -c
+    row = 2 * nq
     for from_q, force, tj in blocks:
         r = from_q.shape[1]
-        a[:, 6:12, row:row + r] = force
+        a[:, nq:nq + 6, row:row + r] = force
         a[:, row:row + r, :6] = from_q / tj
         a[:, row:row + r, row:row + r] = -np.eye(r) / tj
         row += r
-    a[:, 6:12, :6] = -kk
+    a[:, nq:2 * nq, :nq] = -kk
     return e, a
 
 
@@ -171,7 +174,7 @@ def _dynamic(lam: complex, m, c, k, stiff: Array, model: Model, terms, exact: bo
     f = lam * lam * m + lam * c + k + 0j
     for j, (i, _, g, tau) in enumerate(terms):
         r = model.mounts[i].viscoelastic.ratio_at(lam) if exact else prony_ratio(lam, g, tau)
-        f = f + stiff[j] * (complex(r) - 1.0)
+        f[:6, :6] += stiff[j] * (complex(r) - 1.0)   # the body's dofs (internal beam dofs after them)
     return f
 
 
@@ -179,24 +182,8 @@ def _d_dynamic_stiffness(lam: complex, m, c, stiff: Array, model: Model, terms) 
     """``dF / d lambda`` with the exact laws (``stiff`` as :func:`_dynamic`)."""
     f = 2.0 * lam * m + c + 0j
     for j, (i, _, _, _) in enumerate(terms):
-        f = f + stiff[j] * model.mounts[i].viscoelastic.dratio_at(lam)
+        f[:6, :6] += stiff[j] * model.mounts[i].viscoelastic.dratio_at(lam)
     return f
-
-
-def refuse_massive_beams(model: Model) -> None:
-    """One-line :class:`~impstab.errors.ModelError` for a model with viscoelastic mounts and beam mounts
-    with mass: the augmented system of the internal variables is built on the body's 6 dofs and does
-    not carry the beams' internal dofs (it dropped the beams' inertia without a word)."""
-    if not model.is_viscoelastic:
-        return
-    for i, mt in enumerate(model.mounts):
-        if mt.is_massive_beam:
-            from ..errors import ModelError
-
-            raise ModelError(f"mounts[{i}].beam.density", mt.beam.density,
-                             "beam mounts with mass beside viscoelastic mounts in one model are not supported yet "
-                             "(the internal variables' augmented system does not carry the beams' internal dofs): "
-                             "use density = 0 for the massless beam")
 
 
 @dataclass(frozen=True, eq=False)
@@ -213,18 +200,23 @@ class ViscoelasticFamily:
     reduced : bool
         Drop the internal variables no motion reaches (see :func:`augmented_matrices`): the same
         stability and every other eigenvalue, fewer states (the critical-thrust search uses it).
+    cutoff : float, optional
+        With massive beam mounts, whose internal dofs follow the body's: keep their fixed-interface
+        modes below ``cutoff`` times the body's highest frequency (default that of
+        :class:`~impstab.linear.linearize.ModelFamily`).
     """
 
     model: Model
     linearization: str | None = None
     fluid_frequency: float = 0.0
     reduced: bool = False
+    cutoff: float | None = None
     first_order = True
     n_dof = 6
 
     def __post_init__(self) -> None:
-        refuse_massive_beams(self.model)
-        base = ModelFamily(self.model, self.linearization, damped=True, fluid_frequency=self.fluid_frequency)
+        base = ModelFamily(self.model, self.linearization, damped=True, fluid_frequency=self.fluid_frequency,
+                           cutoff=self.cutoff)
         object.__setattr__(self, "base", base)
         object.__setattr__(self, "linearization", base.linearization)
         object.__setattr__(self, "terms", _terms(self.model))
@@ -253,9 +245,10 @@ class ViscoelasticFamily:
 
     @property
     def n(self) -> int:
+        nq = 2 * self.base.n  # type: ignore[attr-defined]
         if self.reduced:
-            return 12 + sum(self.ranks.values())  # type: ignore[union-attr]
-        return 12 + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
+            return nq + sum(self.ranks.values())  # type: ignore[union-attr]
+        return nq + 3 * sum(len(g) for _, _, g, _ in self.terms)  # type: ignore[attr-defined]
 
     @property
     def weights(self) -> Array:
@@ -263,7 +256,8 @@ class ViscoelasticFamily:
         return np.diag(self.model.mass_matrix).copy()
 
     def system(self, thrusts: Array):
-        """``M, D + G, K`` stacks and the arms at equilibrium ``rho (S, nm, 3)`` at each thrust."""
+        """``M, D + G, K`` stacks (the body's dofs, then those of massive beam mounts) and the arms at
+        equilibrium ``rho (S, nm, 3)`` at each thrust."""
         p = np.atleast_1d(np.asarray(thrusts, dtype=float))
         base: ModelFamily = self.base  # type: ignore[attr-defined]
         if base.is_affine:
@@ -271,6 +265,8 @@ class ViscoelasticFamily:
             rho = np.broadcast_to(self.positions, (p.size,) + self.positions.shape)  # type: ignore[attr-defined]
         else:
             m, d, g, k, _, r0 = base.evaluate(p, strict=False)
+            if base.internal is not None:  # massive beam mounts: their internal dofs after the body's
+                m, d, g, k = base.internal.augment(np.asarray(m), np.asarray(d), np.asarray(g), np.asarray(k), r0)
             rho = np.einsum("sab,mb->sma", r0, self.positions)  # type: ignore[attr-defined]
         return np.asarray(m), np.asarray(d + g), np.asarray(k), rho
 
@@ -287,8 +283,9 @@ class ViscoelasticFamily:
         rho = self.positions[None]  # type: ignore[attr-defined]
         e, a0 = augmented_matrices(m[None], (d + g)[None], k0[None], rho, self.terms, self.reduced,  # type: ignore[attr-defined]
                                    self.ranks, tuple(x[None] for x in self.rest_maps))
+        nq = m.shape[-1]
         a1 = np.zeros_like(a0[0])
-        a1[6:12, :6] = -k1
+        a1[nq:2 * nq, :nq] = -k1
         return e[0], a0[0], a1
 
 
@@ -427,7 +424,8 @@ def viscoelastic_modes(model: Model, thrust: float = 0.0, linearization: str | N
     e, a = augmented_matrices(m, c, k, rho, fam.terms)  # type: ignore[attr-defined]
     vals, vecs = np.linalg.eig(np.linalg.solve(e[0], a[0]))
     scale = max(np.abs(vals).max(), 1e-300)
-    q = vecs[:6]
+    nq = m.shape[-1]                     # the body's 6 dofs, then those of massive beam mounts
+    q = vecs[:nq]
     size = np.linalg.norm(q, axis=0) / np.maximum(np.linalg.norm(vecs, axis=0), 1e-300)
     keep = ((vals.imag > 1e-12 * scale) | (np.abs(vals.imag) <= 1e-12 * scale)) & (size > 1e-10)
     vals, vecs = vals[keep], q[:, keep]
@@ -435,6 +433,16 @@ def viscoelastic_modes(model: Model, thrust: float = 0.0, linearization: str | N
     order = np.lexsort((vals.real, np.abs(vals.imag)))
     vals, vecs = vals[order], vecs[:, order]
     vecs = _canonical_repeated(vals, vecs, np.diag(m[0]))
-    big = np.argmax(np.abs(vecs), axis=0)
-    shapes = vecs / vecs[big, np.arange(vecs.shape[1])]
-    return ModalResult(float(thrust), fam.linearization, vals, shapes, energy_shares(shapes, m[0]))  # type: ignore[arg-type]
+    extra = {}
+    if nq > 6:  # massive beam mounts: the internal dofs' share of each mode's kinetic energy
+        energy = (vecs.conj() * (m[0] @ vecs)).real
+        total = energy.sum(axis=0)
+        extra = dict(internal_share=energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0),
+                     mount_elements=tuple(int(mt.beam.elements) for mt in model.mounts if mt.is_massive_beam),
+                     internal_dofs=nq - 6)
+    body = vecs[:6]
+    big = np.argmax(np.abs(body), axis=0)
+    piv = body[big, np.arange(body.shape[1])]
+    shapes = body / np.where(piv != 0, piv, 1.0)
+    return ModalResult(float(thrust), fam.linearization, vals, shapes, energy_shares(shapes, m[0][:6, :6]),  # type: ignore[arg-type]
+                       **extra)
