@@ -386,7 +386,7 @@ def _grown_modes(model: Model, thrust: float, linearization: str | None, fluid_f
     vecs = _canonical_repeated(vals, vecs, np.diag(m))
     energy = (vecs.conj() * (m @ vecs)).real                     # (n, k)
     total = energy.sum(axis=0)
-    internal = energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0)
+    internal = np.clip(energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0), 0.0, 1.0)  # rounding: no -0.0
     body = vecs[:6]
     big = np.argmax(np.abs(body), axis=0)
     piv = body[big, np.arange(body.shape[1])]

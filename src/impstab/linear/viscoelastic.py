@@ -437,7 +437,7 @@ def viscoelastic_modes(model: Model, thrust: float = 0.0, linearization: str | N
     if nq > 6:  # massive beam mounts: the internal dofs' share of each mode's kinetic energy
         energy = (vecs.conj() * (m[0] @ vecs)).real
         total = energy.sum(axis=0)
-        extra = dict(internal_share=energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0),
+        extra = dict(internal_share=np.clip(energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0), 0.0, 1.0),
                      mount_elements=tuple(int(mt.beam.elements) for mt in model.mounts if mt.is_massive_beam),
                      internal_dofs=nq - 6)
     body = vecs[:6]
