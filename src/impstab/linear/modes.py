@@ -28,7 +28,7 @@ from .critical import TOL_DUPLICATE
 from .linearize import linearize
 from .system import LinearSystem
 
-__all__ = ["ModalResult", "modes", "modes_of_system", "coupling_centre", "energy_shares"]
+__all__ = ["ModalResult", "modes", "modes_of_system", "coupling_centre", "energy_shares", "body_modes"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -384,15 +384,24 @@ def _grown_modes(model: Model, thrust: float, linearization: str | None, fluid_f
     order = np.lexsort((vals.real, np.abs(vals.imag)))
     vals, vecs = vals[order], vecs[:, order]
     vecs = _canonical_repeated(vals, vecs, np.diag(m))
-    energy = (vecs.conj() * (m @ vecs)).real                     # (n, k)
-    total = energy.sum(axis=0)
-    internal = np.clip(energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0), 0.0, 1.0)  # rounding: no -0.0
+    return body_modes(model, float(thrust), fam.linearization, vals, vecs, m)  # type: ignore[arg-type]
+
+
+def body_modes(model: Model, thrust: float, linearization: str, vals, vecs, m) -> ModalResult:
+    """The :class:`ModalResult` of eigenvalues ``vals (k,)`` with displacement vectors ``vecs (nq, k)``
+    of mass ``m (nq, nq)``: shapes and decoupling table of the body's 6 dofs; with massive beam
+    mounts (their internal dofs after the body's, ``nq - 6`` of them) each mode's internal share of
+    kinetic energy."""
+    extra = {}
+    nq = m.shape[0]
+    if any(mt.is_massive_beam for mt in model.mounts):
+        energy = (vecs.conj() * (m @ vecs)).real                 # (nq, k)
+        total = energy.sum(axis=0)
+        internal = np.clip(energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0), 0.0, 1.0)  # rounding: no -0.0
+        extra = dict(internal_share=internal, internal_dofs=nq - 6,
+                     mount_elements=tuple(int(mt.beam.elements) for mt in model.mounts if mt.is_massive_beam))
     body = vecs[:6]
     big = np.argmax(np.abs(body), axis=0)
     piv = body[big, np.arange(body.shape[1])]
     shapes = body / np.where(piv != 0, piv, 1.0)
-    part = energy_shares(shapes, m[:6, :6])
-    beams = [mt.beam for mt in model.mounts if mt.is_massive_beam]
-    return ModalResult(float(thrust), fam.linearization, vals, shapes, part,  # type: ignore[arg-type]
-                       internal_share=internal, mount_elements=tuple(int(b.elements) for b in beams),
-                       internal_dofs=n - 6)
+    return ModalResult(thrust, linearization, vals, shapes, energy_shares(shapes, m[:6, :6]), **extra)  # type: ignore[arg-type]

@@ -413,7 +413,7 @@ def viscoelastic_modes(model: Model, thrust: float = 0.0, linearization: str | N
     table are those of the displacement states ``q``. Roots whose displacement part vanishes
     (an internal variable that no motion of the body excites) are left out.
     """
-    from .modes import ModalResult, _canonical_repeated, energy_shares
+    from .modes import _canonical_repeated, body_modes
 
     fam = ViscoelasticFamily(model, linearization)
     m, c, k, rho = fam.system(np.array([float(thrust)]))
@@ -433,16 +433,4 @@ def viscoelastic_modes(model: Model, thrust: float = 0.0, linearization: str | N
     order = np.lexsort((vals.real, np.abs(vals.imag)))
     vals, vecs = vals[order], vecs[:, order]
     vecs = _canonical_repeated(vals, vecs, np.diag(m[0]))
-    extra = {}
-    if nq > 6:  # massive beam mounts: the internal dofs' share of each mode's kinetic energy
-        energy = (vecs.conj() * (m[0] @ vecs)).real
-        total = energy.sum(axis=0)
-        extra = dict(internal_share=np.clip(energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0), 0.0, 1.0),
-                     mount_elements=tuple(int(mt.beam.elements) for mt in model.mounts if mt.is_massive_beam),
-                     internal_dofs=nq - 6)
-    body = vecs[:6]
-    big = np.argmax(np.abs(body), axis=0)
-    piv = body[big, np.arange(body.shape[1])]
-    shapes = body / np.where(piv != 0, piv, 1.0)
-    return ModalResult(float(thrust), fam.linearization, vals, shapes, energy_shares(shapes, m[0][:6, :6]),  # type: ignore[arg-type]
-                       **extra)
+    return body_modes(model, float(thrust), fam.linearization, vals, vecs, m[0])  # type: ignore[arg-type]
