@@ -48,7 +48,7 @@ from ..errors import ModelError
 from ..model.model import DOF_NAMES, Model
 
 __all__ = ["SIM_CUTOFF", "OSCILLATION_LIMIT", "BeamRoots", "beam_dofs", "pack_beams", "no_beams", "fastest_root",
-           "check_beam_step"]
+           "check_beam_step", "modal_length_factors"]
 
 #: the time histories keep the beams' fixed-interface modes below this multiple of the body's
 #: highest natural frequency (the stability analysis: :data:`~impstab.linear.mount_dofs.CUTOFF`)
@@ -64,6 +64,13 @@ def beam_dofs(model: Model):
     from ..linear.mount_dofs import mount_dofs
 
     return mount_dofs(model, cutoff=SIM_CUTOFF)
+
+
+def modal_length_factors(model: Model, system) -> np.ndarray:
+    """``sqrt(m_b)`` (kg^0.5) of the beam of each kept mode of a packed
+    :class:`~impstab.dynamics.system.DynamicSystem`: a modal coordinate (unit modal mass, kg^0.5 m)
+    divided by it is a length, the unit the error weights and state scales use."""
+    return np.sqrt([model.mounts[i].beam.mass for i in system.mode_mounts])
 
 
 def no_beams(mass6) -> tuple:

@@ -19,7 +19,7 @@ from .loading import Perturbation, as_thrust_history
 from .rhs import N_BODY, PITCH_LIMIT
 from .system import pack_dynamics
 from .result import SimulationResult
-from .beam_mounts import beam_dofs, check_beam_step, fastest_root
+from .beam_mounts import beam_dofs, check_beam_step, fastest_root, modal_length_factors
 from .viscoelastic import augmented_roots, check_explicit_step, step_limit
 
 __all__ = ["simulate", "check_work", "check_step", "StepSizeWarning", "STEPS_PER_PERIOD", "fastest_mode", "default_step", "MAX_SAMPLES"]
@@ -129,12 +129,18 @@ def check_step(model: Model, thrust: float, integrator: str, dt: float | None, n
     beams = _has_beams(model)
     if dt is None or not (model.is_viscoelastic or beams) or not get_integrator(integrator).fixed_step:
         return
-    name = get_integrator(integrator).name
     omega, _, rate = _fastest(model, linearize(model, float(thrust), "equilibrium"))
-    field = (names or PYTHON_NAMES)["dt"]
-    check_explicit_step(model, name, float(dt), rate, field)
+    _refuse_unstable_step(model, get_integrator(integrator).name, float(dt), omega, rate, beams,
+                          (names or PYTHON_NAMES)["dt"])
+
+
+def _refuse_unstable_step(model: Model, integrator: str, dt: float, omega: float, rate: float, beams: bool,
+                          field: str = "dt") -> None:
+    """The explicit step ``dt`` against its stability limits: the fastest viscoelastic relaxation
+    ``rate`` (1/s) and, with massive beam mounts, the fastest root ``omega`` (rad/s)."""
+    check_explicit_step(model, integrator, dt, rate, field)
     if beams:
-        check_beam_step(model, name, float(dt), omega, field)
+        check_beam_step(model, integrator, dt, omega, field)
 
 
 #: the argument names of :func:`simulate` in the messages of :func:`check_work`
@@ -276,9 +282,7 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
             rate = max(rate, rt)
     h_limit = step_limit(omega, rate, STEPS_PER_PERIOD)
     if solver.fixed_step and dt is not None:
-        check_explicit_step(model, solver.name, dt, rate)
-        if system.n_modes:
-            check_beam_step(model, solver.name, dt, omega)
+        _refuse_unstable_step(model, solver.name, dt, omega, rate, bool(system.n_modes))
         if dt > h_limit * (1 + 1e-9):
             what = (f"the fastest mode ({mode}, {omega / (2 * math.pi):.4g} Hz)" if omega >= rate else
                     f"the fastest relaxation of the viscoelastic internal variables ({rate:.4g} 1/s)")
@@ -303,7 +307,7 @@ def simulate(model: Model, thrust, duration: float, integrator: str = "hamming",
 
     # error weights make every state a length; the internal variables are lengths (m), a beam's
     # modal coordinate (kg^0.5 m) over the square root of the beam's mass is one
-    root_mass = np.sqrt([model.mounts[i].beam.mass for i in system.mode_mounts])
+    root_mass = modal_length_factors(model, system)
     weights = np.concatenate([[1, 1, 1, length, length, length], [1 / omega] * 3, [length / omega] * 3,
                               np.ones(3 * system.n_terms), 1 / root_mass, 1 / (root_mass * omega)])
     # absolute tolerance (in metres after weighting): rtol x the initial deviation, floored at

@@ -64,7 +64,7 @@ class DynamicSystem:
     @property
     def mode_start(self) -> int:
         """First state of the beams' modal coordinates: ``12 + 3 n_terms``."""
-        return 12 + 3 * self.n_terms
+        return N_BODY + 3 * self.n_terms
 
     @property
     def mode_mounts(self) -> NDArray[np.int64]:

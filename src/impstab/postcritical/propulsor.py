@@ -70,6 +70,7 @@ MOUNT_SAMPLES = 128
 def propulsor_system(model, omega: float | None = None) -> tuple[DynamicalSystem, object]:
     """The model's equations of motion as a :class:`DynamicalSystem` in the thrust (N), and the
     :class:`~impstab.dynamics.system.NonlinearSystem` that evaluates them."""
+    from ..dynamics.beam_mounts import modal_length_factors
     from ..dynamics.system import NonlinearSystem
 
     ns = NonlinearSystem(model)
@@ -79,7 +80,7 @@ def propulsor_system(model, omega: float | None = None) -> tuple[DynamicalSystem
     an = DEFAULTS["angle_scale"]
     n_internal = 3 * ns.system.n_terms  # viscoelastic internal variables (m): scaled like the position of A
     n_modes = ns.system.n_modes         # beam modal coordinates (kg^0.5 m): the position scale x sqrt(beam mass)
-    root_mass = np.sqrt([model.mounts[i].beam.mass for i in ns.system.mode_mounts])
+    root_mass = modal_length_factors(model, ns.system)
     scale = np.concatenate([[xs] * 3 + [an] * 3 + [w * xs] * 3 + [w * an] * 3 + [xs] * n_internal,
                             xs * root_mass, w * xs * root_mass])
     names = (STATE_NAMES + tuple(f"w{j}_{a}" for j in range(n_internal // 3) for a in "xyz")
