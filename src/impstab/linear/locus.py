@@ -526,7 +526,7 @@ def _conjugate_groups(lam: NDArray[np.complex128], vectors: NDArray | None = Non
             continue
         sure = rows & unique[:, a]
         votes = np.bincount(partner[sure if sure.any() else rows, a], minlength=k)
-        votes[taken | (label != np.arange(k))] = 0
+        votes[taken] = 0
         votes[a] = 0
         if votes.max() == 0:
             continue

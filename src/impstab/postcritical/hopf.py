@@ -592,7 +592,6 @@ def _degeneracy(jac, mass, spec: Spectrum, idx, lam, kappa, dlam, scale, states=
                 "not apply"), null
     if not math.isfinite(dlam.real):
         return "the crossing speed d sigma/dp is not finite", 1
-    speed = abs(dlam)
     if abs(dlam.real) <= TRANSVERSALITY_TOLERANCE * max(speed, 1e-300):
         if symmetric_spectrum:
             return ("reversible / undamped: the pair stays on the imaginary axis (d sigma/dp = 0, spectrum symmetric "
