@@ -214,7 +214,7 @@ def test_coupled_blocks_match_lapack_on_the_asymmetric_propulsor():
     # the compiled route itself (eig_affine would hide its failures behind LAPACK)
     vals, vecs, inv = np.empty((len(loads), 6), complex), np.empty((len(loads), 6, 6), complex), np.empty((len(loads), 6, 6), complex)
     ok = np.zeros(len(loads), dtype=bool)
-    _eig_blocks(a0, a1, loads, bs.order, bs.starts, bs.nblocks, vals, vecs, inv, ok)
+    _eig_blocks(a0, a1, loads, bs.order, bs.starts, bs.nblocks, bs.mirror, vals, vecs, inv, ok)
     ref_vals, ref_vecs, ref_inv, ref_ok = eig_affine(a0, a1, loads, None)
     assert ok.all() and ref_ok.all()
     for s in range(len(loads)):
@@ -227,3 +227,80 @@ def test_coupled_blocks_match_lapack_on_the_asymmetric_propulsor():
             j = int(np.argmin(np.abs(ref_vals[s] - vals[s, k])))
             overlap = abs(np.vdot(ref_vecs[s][:, j], vecs[s][:, k]))
             assert abs(overlap - 1) <= 1e3 * EPS * cond
+
+
+def _signed_copies(rng, m, copies, noise=0.0):
+    """Block diagonal ``A0, A1``: one random block of order ``m``, ``copies`` signed copies of it
+    (``S B S``, ``S`` random signs, entries perturbed by ``noise`` relative), a different block of
+    the same order, dofs shuffled."""
+    b0, b1 = rng.standard_normal((m, m)) + 3 * np.eye(m), 0.2 * rng.standard_normal((m, m))
+    other0, other1 = rng.standard_normal((m, m)) + 3 * np.eye(m), 0.2 * rng.standard_normal((m, m))
+    parts = [(b0, b1)]
+    for _ in range(copies):
+        s = rng.choice([-1.0, 1.0], m)
+        d = np.outer(s, s)
+        parts.append((d * b0 * (1 + noise * rng.standard_normal((m, m))), d * b1))
+    parts.append((other0, other1))
+    n = m * len(parts)
+    a0, a1 = np.zeros((n, n)), np.zeros((n, n))
+    for i, (x0, x1) in enumerate(parts):
+        a0[i * m:(i + 1) * m, i * m:(i + 1) * m] = x0
+        a1[i * m:(i + 1) * m, i * m:(i + 1) * m] = x1
+    perm = np.argsort(np.tile(np.arange(m), len(parts)) * 10 + np.repeat(np.arange(len(parts)), m))
+    return a0[np.ix_(perm, perm)], a1[np.ix_(perm, perm)]
+
+
+@pytest.mark.parametrize("m", [3, 4, 8])
+def test_signed_copies_of_a_block_are_solved_once_and_match_lapack(m):
+    """Identical planes: a block that is ``S B S`` of an earlier one copies its eigenvalues and
+    takes ``S`` times its eigenvectors; checked against LAPACK on the whole matrix (residual,
+    inverse, values), and a different block of the same order is not taken for a copy."""
+    rng = np.random.default_rng(m)
+    a0, a1 = _signed_copies(rng, m, copies=2)
+    bs = decoupled_blocks(a0[None], a1[None], np.array([2.0]))
+    assert bs.nblocks[0] == 4
+    copied = [b for b in range(4) if bs.mirror[0, bs.starts[0, b]] != 0]
+    assert len(copied) == 2  # the two copies; the source and the different block are solved
+    loads = np.array([[0.0, 0.7, 2.0]])
+    vals = eigvals_affine_blocks(a0[None], a1[None], loads, bs)
+    for k, p in enumerate(loads[0]):
+        ref = np.linalg.eigvals(a0 + p * a1)
+        assert _match(vals[0, k], ref) <= 1e-12 * np.abs(ref).max()
+    v, w, u, ok = eig_affine(a0[None], a1[None], np.array([0.7]), bs)
+    a = a0 + 0.7 * a1
+    assert ok[0]
+    assert np.abs(a @ w[0] - w[0] * v[0]).max() <= 1e-12 * np.abs(a).max()
+    assert np.abs(u[0] @ w[0] - np.eye(len(a))).max() <= 1e-11
+
+
+def test_a_copy_beyond_rounding_is_solved_on_its_own():
+    """A block that differs from a signed copy by more than the decoupling tolerance (1e-10 of its
+    entries) is not taken for one: its own eigenvalues, not those of the other."""
+    rng = np.random.default_rng(11)
+    a0, a1 = _signed_copies(rng, 4, copies=1, noise=1e-10)
+    bs = decoupled_blocks(a0[None], a1[None], np.array([2.0]))
+    assert not bs.mirror.any()
+    a0r, a1r = _signed_copies(np.random.default_rng(11), 4, copies=1, noise=1e-17)
+    assert decoupled_blocks(a0r[None], a1r[None], np.array([2.0])).mirror.any()  # rounding: a copy
+
+
+def test_a_block_the_load_does_not_change_is_solved_once():
+    """A block with ``A1 = 0`` (surge and roll under an axial thrust) keeps the eigenvalues it has at
+    ``p = 0``; they equal LAPACK's at every load, and a block the load does change (even by 1e-9 of
+    its entries) is solved at each load."""
+    rng = np.random.default_rng(5)
+    a0, a1 = np.zeros((11, 11)), np.zeros((11, 11))
+    a0[:4, :4] = rng.standard_normal((4, 4)) + 3 * np.eye(4)          # constant
+    a0[4:7, 4:7] = rng.standard_normal((3, 3)) + 3 * np.eye(3)        # changes with the load
+    a1[4:7, 4:7] = 0.3 * rng.standard_normal((3, 3))
+    a0[7:, 7:] = rng.standard_normal((4, 4)) + 3 * np.eye(4)          # changes by 1e-9 of its entries
+    a1[7:, 7:] = 1e-9 * rng.standard_normal((4, 4))
+    bs = decoupled_blocks(a0[None], a1[None], np.array([2.0]))
+    fixed = {tuple(sorted(bs.order[0, bs.starts[0, b]:bs.starts[0, b + 1]])): bs.fixed[0, bs.starts[0, b]]
+             for b in range(bs.nblocks[0])}
+    assert not np.isnan(fixed[(0, 1, 2, 3)]) and np.isnan(fixed[(4, 5, 6)]) and np.isnan(fixed[(7, 8, 9, 10)])
+    loads = np.array([[0.0, 1.3, 2.0]])
+    vals = eigvals_affine_blocks(a0[None], a1[None], loads, bs)
+    for k, p in enumerate(loads[0]):
+        ref = np.linalg.eigvals(a0 + p * a1)
+        assert _match(vals[0, k], ref) <= 1e-12 * np.abs(ref).max()

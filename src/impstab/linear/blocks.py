@@ -67,24 +67,92 @@ class BlockStructure:
         Number of blocks.
     largest : (N,) int array
         Size of the largest block (1 for a diagonal operator, ``n`` for a coupled one).
+    mirror : (N, n) int array
+        0 at the positions of ``order`` in a block solved on its own. A block of three dofs or
+        more that is a signed copy of an earlier one (``A_b = S A_c S`` over the load range, ``S``
+        a diagonal of signs: the identical planes of a symmetric layout) is not solved again: at
+        its ``k``-th position ``mirror = s_k (i + 1)``, ``i`` the position of the ``k``-th dof of
+        block ``c`` and ``s_k = +-1``. Its eigenvalues are those of ``c``, its eigenvectors ``S``
+        times those of ``c``.
+    fixed : (N, n) complex array
+        The eigenvalues, at the positions of ``order``, of each block of three dofs or more that
+        does not change over the load range (``p_max A1`` within the decoupling tolerance on it:
+        the surge and roll motions of a symmetric layout under an axial thrust), computed once;
+        NaN elsewhere.
     """
 
     order: NDArray[np.int64]
     starts: NDArray[np.int64]
     nblocks: NDArray[np.int64]
     largest: NDArray[np.int64]
+    mirror: NDArray[np.int64]
+    fixed: NDArray[np.complex128]
 
     def take(self, rows: NDArray) -> "BlockStructure":
         """The structure of the designs ``rows``."""
-        return BlockStructure(self.order[rows], self.starts[rows], self.nblocks[rows], self.largest[rows])
+        return BlockStructure(self.order[rows], self.starts[rows], self.nblocks[rows], self.largest[rows],
+                              self.mirror[rows], self.fixed[rows])
 
 
 @njit(cache=True, error_model="numpy")
-def _structure(a0, a1, p_max, tol, order, starts, nblocks, largest):
+def _mirror_signs(a0, a1, s, p_max, order, lo, src, m, f, limit, signs):
+    """Signs ``S`` with block ``lo`` of design ``s`` equal to ``S (block src) S`` within ``limit``
+    (balanced units, at ``p = 0`` and ``p_max`` alike) into ``signs[:m]``; False: not such a copy."""
+    for x in range(m):
+        signs[x] = 0
+    signs[0] = 1
+    for _ in range(m):  # spread the signs along the couplings (a block is connected)
+        for x in range(m):
+            if signs[x] != 0:
+                continue
+            for y in range(m):
+                if signs[y] == 0:
+                    continue
+                for a, b in ((x, y), (y, x)):
+                    i, j = order[s, lo + a], order[s, lo + b]
+                    k, l = order[s, src + a], order[s, src + b]
+                    w = f[j] / f[i]
+                    here = a0[s, i, j] + p_max * a1[s, i, j]
+                    there = a0[s, k, l] + p_max * a1[s, k, l]
+                    if abs(there) * w > limit and abs(here) * w > limit:
+                        signs[x] = signs[y] if (here > 0) == (there > 0) else -signs[y]
+                        break
+                if signs[x] != 0:
+                    break
+    for x in range(m):
+        if signs[x] == 0:
+            return False
+    for x in range(m):
+        for y in range(m):
+            i, j = order[s, lo + x], order[s, lo + y]
+            k, l = order[s, src + x], order[s, src + y]
+            w = f[j] / f[i]
+            d = signs[x] * signs[y]
+            if (abs(a0[s, i, j] - d * a0[s, k, l]) + abs(p_max) * abs(a1[s, i, j] - d * a1[s, k, l])) * w > limit:
+                return False
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def _load_free(a1, s, p_max, order, lo, m, f, limit):
+    """Whether ``p_max A1`` on the block at ``lo`` is within ``limit`` (balanced units) everywhere."""
+    for x in range(m):
+        for y in range(m):
+            i, j = order[s, lo + x], order[s, lo + y]
+            if abs(p_max * a1[s, i, j]) * f[j] / f[i] > limit:
+                return False
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def _structure(a0, a1, p_max, tol, order, starts, nblocks, largest, mirror, fixed):
     count, n = a0.shape[0], a0.shape[1]
     c = np.empty((n, n))
     f = np.empty(n)
     label = np.empty(n, dtype=np.int64)
+    signs = np.empty(n, dtype=np.int64)
+    blk = np.empty((n, n))
+    v, wr, wi = np.empty(n), np.empty(n), np.empty(n)
     for s in range(count):
         for i in range(n):
             for j in range(n):
@@ -132,6 +200,31 @@ def _structure(a0, a1, p_max, tol, order, starts, nblocks, largest):
             starts[s, r] = n
         nblocks[s] = b
         largest[s] = big
+        for i in range(n):
+            mirror[s, i] = 0
+            fixed[s, i] = complex(np.nan, np.nan)
+        if not finite:
+            continue
+        for bb in range(b):  # a block of three dofs or more that the load does not change: solved once
+            lo, m = starts[s, bb], starts[s, bb + 1] - starts[s, bb]
+            if m < 3 or not _load_free(a1, s, p_max[s], order, lo, m, f, limit):
+                continue
+            _fill_block(a0, a1, s, 0.0, order, lo, m, blk)
+            if not _solve_one(blk, m, v, wr, wi, fixed[s, lo:lo + m]):
+                for x in range(m):
+                    fixed[s, lo + x] = complex(np.nan, np.nan)
+        for bb in range(1, b):  # a block of three dofs or more that copies an earlier one
+            lo, m = starts[s, bb], starts[s, bb + 1] - starts[s, bb]
+            if m < 3:
+                continue
+            for cc in range(bb):
+                src = starts[s, cc]
+                if starts[s, cc + 1] - src != m or mirror[s, src] != 0:
+                    continue
+                if _mirror_signs(a0, a1, s, p_max[s], order, lo, src, m, f, limit, signs):
+                    for x in range(m):
+                        mirror[s, lo + x] = signs[x] * (src + x + 1)
+                    break
 
 
 def decoupled_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], p_max: NDArray[np.float64]) -> BlockStructure:
@@ -155,8 +248,11 @@ def decoupled_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], p_max: ND
     starts = np.empty((count, n + 1), dtype=np.int64)
     nblocks = np.empty(count, dtype=np.int64)
     largest = np.empty(count, dtype=np.int64)
-    _structure(a0, a1, np.ascontiguousarray(p_max, dtype=float), TOL_DECOUPLE, order, starts, nblocks, largest)
-    return BlockStructure(order, starts, nblocks, largest)
+    mirror = np.empty((count, n), dtype=np.int64)
+    fixed = np.empty((count, n), dtype=np.complex128)
+    _structure(a0, a1, np.ascontiguousarray(p_max, dtype=float), TOL_DECOUPLE, order, starts, nblocks, largest,
+               mirror, fixed)
+    return BlockStructure(order, starts, nblocks, largest, mirror, fixed)
 
 
 @njit(cache=True, error_model="numpy")
@@ -204,16 +300,26 @@ def _fill_block(a0, a1, s, p, order, lo, m, w):
 
 
 @njit(cache=True, error_model="numpy")
-def block_eigvals_at(a0, a1, s, p, order, starts, nblocks, w, v, wr, wi, out):
+def block_eigvals_at(a0, a1, s, p, order, starts, nblocks, mirror, fixed, w, v, wr, wi, out):
     """Eigenvalues of design ``s`` at load ``p``, block by block, into ``out (n,)``; False: failed.
 
-    ``w (n, n)``, ``v, wr, wi (n,)`` are work arrays.
+    ``w (n, n)``, ``v, wr, wi (n,)`` are work arrays; ``mirror``, ``fixed`` as in
+    :class:`BlockStructure`.
     """
     n = a0.shape[1]
     good = True
     for b in range(nblocks[s]):
         lo, hi = starts[s, b], starts[s, b + 1]
         m = hi - lo
+        if not np.isnan(fixed[s, lo].real):  # the same at every load
+            for x in range(m):
+                out[lo + x] = fixed[s, lo + x]
+            continue
+        if mirror[s, lo] != 0:  # a signed copy of an earlier block: the same eigenvalues
+            src = abs(mirror[s, lo]) - 1
+            for x in range(m):
+                out[lo + x] = out[src + x]
+            continue
         _fill_block(a0, a1, s, p, order, lo, m, w)
         if m == 1:
             out[lo] = complex(w[0, 0], 0.0)
@@ -229,13 +335,14 @@ def block_eigvals_at(a0, a1, s, p, order, starts, nblocks, w, v, wr, wi, out):
 
 
 @njit(cache=True, error_model="numpy")
-def _eigvals_blocks(a0, a1, loads, order, starts, nblocks, out, ok):
+def _eigvals_blocks(a0, a1, loads, order, starts, nblocks, mirror, fixed, out, ok):
     n = a0.shape[1]
     w = np.empty((n, n))
     v, wr, wi = np.empty(n), np.empty(n), np.empty(n)
     for s in range(a0.shape[0]):
         for k in range(loads.shape[1]):
-            ok[s, k] = block_eigvals_at(a0, a1, s, loads[s, k], order, starts, nblocks, w, v, wr, wi, out[s, k])
+            ok[s, k] = block_eigvals_at(a0, a1, s, loads[s, k], order, starts, nblocks, mirror, fixed, w, v, wr, wi,
+                                        out[s, k])
 
 
 def eigvals_affine_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[np.float64],
@@ -250,7 +357,8 @@ def eigvals_affine_blocks(a0: NDArray[np.float64], a1: NDArray[np.float64], load
     loads = np.ascontiguousarray(loads, dtype=float)
     out = np.empty(loads.shape + (a0.shape[-1],), dtype=np.complex128)
     ok = np.ones(loads.shape, dtype=np.bool_)
-    _eigvals_blocks(a0, a1, loads, blocks.order, blocks.starts, blocks.nblocks, out, ok)
+    _eigvals_blocks(a0, a1, loads, blocks.order, blocks.starts, blocks.nblocks, blocks.mirror, blocks.fixed,
+                    out, ok)
     if not ok.all():
         s, k = np.nonzero(~ok)
         out[s, k] = eigvals_affine(a0[s], a1[s], loads[s, k][:, None])[:, 0]
@@ -267,7 +375,7 @@ def eig_workspace(n):
 
 
 @njit(cache=True, error_model="numpy")
-def block_eig_at(a0, a1, s, p, order, starts, nblocks, vals, vecs, inv, ws):
+def block_eig_at(a0, a1, s, p, order, starts, nblocks, mirror, vals, vecs, inv, ws):
     """Eigen-decomposition of design ``s`` at load ``p``, block by block; False: failed.
 
     Closed forms up to two dofs, else compiled QR and inverse iteration
@@ -284,6 +392,16 @@ def block_eig_at(a0, a1, s, p, order, starts, nblocks, vals, vecs, inv, ws):
     for b in range(nblocks[s]):
         lo, hi = starts[s, b], starts[s, b + 1]
         m = hi - lo
+        if mirror[s, lo] != 0:  # A_b = S A_c S: the values of c, vectors S V_c, inverse V_c^-1 S
+            src = abs(mirror[s, lo]) - 1
+            for xx in range(m):
+                vals[lo + xx] = vals[src + xx]
+                sx = 1.0 if mirror[s, lo + xx] > 0 else -1.0
+                for yy in range(m):
+                    sy = 1.0 if mirror[s, lo + yy] > 0 else -1.0
+                    vecs[order[s, lo + xx], lo + yy] = sx * vecs[order[s, src + xx], src + yy]
+                    inv[lo + xx, order[s, lo + yy]] = inv[src + xx, order[s, src + yy]] * sy
+            continue
         _fill_block(a0, a1, s, p, order, lo, m, w0)
         if m == 1:
             r = order[s, lo]
@@ -325,11 +443,11 @@ def block_eig_at(a0, a1, s, p, order, starts, nblocks, vals, vecs, inv, ws):
 
 
 @njit(cache=True, error_model="numpy")
-def _eig_blocks(a0, a1, loads, order, starts, nblocks, vals, vecs, inv, ok):
+def _eig_blocks(a0, a1, loads, order, starts, nblocks, mirror, vals, vecs, inv, ok):
     """Eigen-decomposition of each design, block by block (closed forms up to two dofs)."""
     ws = eig_workspace(a0.shape[1])
     for s in range(a0.shape[0]):
-        ok[s] = block_eig_at(a0, a1, s, loads[s], order, starts, nblocks, vals[s], vecs[s], inv[s], ws)
+        ok[s] = block_eig_at(a0, a1, s, loads[s], order, starts, nblocks, mirror, vals[s], vecs[s], inv[s], ws)
 
 
 def _lapack(ops: NDArray[np.float64]) -> tuple:
@@ -389,13 +507,13 @@ def eig_affine(a0: NDArray[np.float64], a1: NDArray[np.float64], loads: NDArray[
     inv = np.empty((count, n, n), dtype=np.complex128)
     ok = np.zeros(count, dtype=np.bool_)
     if blocks is not None and compiled.all():  # the usual case: no copies
-        _eig_blocks(a0, a1, loads, blocks.order, blocks.starts, blocks.nblocks, vals, vecs, inv, ok)
+        _eig_blocks(a0, a1, loads, blocks.order, blocks.starts, blocks.nblocks, blocks.mirror, vals, vecs, inv, ok)
     elif compiled.any():
         rows = np.flatnonzero(compiled)
         sub = blocks.take(rows)
         v, w, u, good = (np.empty((len(rows), n), np.complex128), np.empty((len(rows), n, n), np.complex128),
                          np.empty((len(rows), n, n), np.complex128), np.zeros(len(rows), np.bool_))
-        _eig_blocks(a0[rows], a1[rows], loads[rows], sub.order, sub.starts, sub.nblocks, v, w, u, good)
+        _eig_blocks(a0[rows], a1[rows], loads[rows], sub.order, sub.starts, sub.nblocks, sub.mirror, v, w, u, good)
         vals[rows], vecs[rows], inv[rows], ok[rows] = v, w, u, good
     rest = np.flatnonzero(~ok)
     if rest.size:

@@ -7,7 +7,8 @@
   :data:`N_SCAN`, :data:`CHUNK` (scan points classified per call), :data:`LARGEST` (largest
   decoupled block);
 * ``span (J, 2)``: ``p_min, p_max``; ``grids (J, G)``: the scan grid (``N_SCAN + 1`` points);
-* ``a0, a1 (J, N, N)``; ``order, starts, nblocks``: the decoupled blocks
+* ``a0, a1 (J, N, N)``; ``order, starts, nblocks, mirror, fixed``: the decoupled blocks, the
+  signed copies among them and the eigenvalues of those the load does not change
   (:class:`impstab.linear.blocks.BlockStructure`); ``weights (J, n_dof)``: participation weights.
 
 Results:
@@ -28,7 +29,7 @@ from collections import namedtuple
 
 __all__ = ["Jobs"]
 
-Jobs = namedtuple("Jobs", "ints span grids a0 a1 order starts nblocks weights")
+Jobs = namedtuple("Jobs", "ints span grids a0 a1 order starts nblocks mirror fixed weights")
 
 FORM, AFFINE, KEY, N_SCAN, CHUNK, LARGEST = 0, 1, 2, 3, 4, 5
 LOAD, KIND, OMEGA, DIRECTION, WARNED, LO, HI = 0, 1, 2, 3, 4, 5, 6

@@ -91,7 +91,7 @@ def _jobs(problems: list[Problem], chunk: int) -> tuple[Jobs, list[int]]:
                         dtype=np.int64)
         grids = _grid(p.p_min, p.p_max, p.n_scan)[None].copy()
         return Jobs(ints, np.array([[p.p_min, p.p_max]]), grids, a0, a1, bs.order, bs.starts, bs.nblocks,
-                    p.weights[None]), []
+                    bs.mirror, bs.fixed, p.weights[None]), []
     n, n_dof = problems[0].order, problems[0].n_dof
     keys = [-1 if p.affine else register(p.provider) for p in problems]
     ints = np.array([(0 if p.undamped else 1, p.affine, k, p.n_scan, 1 if p.affine else chunk, n)
@@ -112,7 +112,8 @@ def _jobs(problems: list[Problem], chunk: int) -> tuple[Jobs, list[int]]:
         bs = decoupled_blocks(a0, a1, np.array([max(abs(p.p_min), abs(p.p_max)) for p in problems]))
         ints[:, LARGEST] = bs.largest
         ints[:, CHUNK] = _affine_chunk(bs.largest)
-        return Jobs(ints, span, grids, a0, a1, bs.order, bs.starts, bs.nblocks, weights), []
+        return Jobs(ints, span, grids, a0, a1, bs.order, bs.starts, bs.nblocks, bs.mirror, bs.fixed,
+                    weights), []
     a0 = np.zeros((count, n, n))
     a1 = np.zeros((count, n, n))
     weights = np.ones((count, n_dof))
@@ -124,12 +125,15 @@ def _jobs(problems: list[Problem], chunk: int) -> tuple[Jobs, list[int]]:
     starts = np.full((count, n + 1), n, dtype=np.int64)
     starts[:, 0] = 0
     nblocks = np.ones(count, dtype=np.int64)
+    mirror = np.zeros((count, n), dtype=np.int64)
+    fixed = np.full((count, n), np.nan + 0j)
     rows = np.flatnonzero(ints[:, AFFINE])
     if rows.size:
         bs = decoupled_blocks(a0[rows], a1[rows], np.abs(span[rows]).max(axis=1))
         order[rows], starts[rows], nblocks[rows], ints[rows, LARGEST] = bs.order, bs.starts, bs.nblocks, bs.largest
+        mirror[rows], fixed[rows] = bs.mirror, bs.fixed
         ints[rows, CHUNK] = _affine_chunk(bs.largest)
-    return Jobs(ints, span, grids, a0, a1, order, starts, nblocks, weights), [k for k in keys if k >= 0]
+    return Jobs(ints, span, grids, a0, a1, order, starts, nblocks, mirror, fixed, weights), [k for k in keys if k >= 0]
 
 
 def _run(jobs: Jobs, n_dof: int, all_crossings: bool):
@@ -187,7 +191,8 @@ def solve_affine(a0: Array, a1: Array, weights: Array, p_max: Array, *, undamped
     bs = decoupled_blocks(a0, a1, np.abs(p_max))
     ints[:, LARGEST] = bs.largest
     ints[:, CHUNK] = _affine_chunk(bs.largest)
-    jobs = Jobs(ints, span, grids, a0, a1, bs.order, bs.starts, bs.nblocks, np.ascontiguousarray(weights, dtype=float))
+    jobs = Jobs(ints, span, grids, a0, a1, bs.order, bs.starts, bs.nblocks, bs.mirror, bs.fixed,
+                np.ascontiguousarray(weights, dtype=float))
     onsets, counts, mode, part = _run(jobs, weights.shape[-1], False)
     rows = np.arange(count)
     start = counts[:, START_UNSTABLE] == 1

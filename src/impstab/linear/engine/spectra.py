@@ -125,7 +125,8 @@ def workspace(n, chunk):
     chunk = max(chunk, 2)
     return (eig_workspace(n), np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n),
             np.empty((chunk, n, n)), np.zeros((1, n, n)), order, starts, np.ones(1, dtype=np.int64),
-            np.empty((chunk, n), dtype=np.complex128), np.empty(chunk, dtype=np.bool_))
+            np.empty((chunk, n), dtype=np.complex128), np.empty(chunk, dtype=np.bool_),
+            np.zeros((1, n), dtype=np.int64))
 
 
 @njit(cache=True, error_model="numpy")
@@ -194,7 +195,7 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
             for i in range(m):
                 lost[i] = False
                 if not block_eigvals_at(jobs.a0, jobs.a1, j, loads[i], jobs.order, jobs.starts, jobs.nblocks,
-                                        w, v, wr, wi, vals[i]):
+                                        jobs.mirror, jobs.fixed, w, v, wr, wi, vals[i]):
                     operators_at(jobs, j, loads[i:i + 1], ops[:1])
                     lost[i] = not _finite(ops[0])
                     if lost[i]:
@@ -228,8 +229,8 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     vals, vecs, inv = c_vals[s], c_vecs[s], c_inv[s]
     ev[0] += 1
     ev[1] += 1
-    if compiled and block_eig_at(jobs.a0, jobs.a1, j, p, jobs.order, jobs.starts, jobs.nblocks, vals, vecs, inv,
-                                 ws[0]):
+    if compiled and block_eig_at(jobs.a0, jobs.a1, j, p, jobs.order, jobs.starts, jobs.nblocks, jobs.mirror,
+                                 vals, vecs, inv, ws[0]):
         c_status[s] = OK
         return OK, s
     if operators_at(jobs, j, loads[:1], ops[:1]) != 0:
@@ -240,7 +241,7 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
         c_status[s] = NOT_FINITE
         vals[:] = np.nan
         return NOT_FINITE, s
-    if n <= MAX_ORDER and block_eig_at(ops[:1], ws[6], 0, 0.0, ws[7], ws[8], ws[9], vals, vecs, inv, ws[0]):
+    if n <= MAX_ORDER and block_eig_at(ops[:1], ws[6], 0, 0.0, ws[7], ws[8], ws[9], ws[12], vals, vecs, inv, ws[0]):
         c_status[s] = OK
         return OK, s
     c_status[s] = _lapack_vectors(ops[0], vals, vecs, inv)
