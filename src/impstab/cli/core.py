@@ -317,6 +317,8 @@ def _viscoelastic_rows(res) -> list[tuple[str, str]]:
     rows = [("viscoelastic mounts", f"{len(fits)} mounts, {terms} Prony terms ({3 * terms} internal states), "
              f"largest fit error {worst:.2e}; undamped = static stiffness")]
     check = res.exact_onset
+    if check is None and res.thrust is not None and worst == 0.0:
+        rows.append(("exact-law check", "none needed: every law is its own Prony series"))
     if check is not None:
         rows.append(("exact-law check", "Newton did not converge" if check.exact_thrust is None else
                      f"Prony onset {check.thrust:.10g} N, exact {check.exact_thrust:.10g} N "

@@ -78,7 +78,8 @@ class CriticalThrust:
     fluid_change: float | None = None
     warnings: tuple[str, ...] = ()
     #: viscoelastic mounts: the onset of the Prony realisation checked on the exact laws
-    #: (:func:`impstab.linear.viscoelastic.exact_onset`), and the fits of the mounts' laws
+    #: (:func:`impstab.linear.viscoelastic.exact_onset`; None where every law is its own Prony
+    #: series, standard linear solid or Prony: nothing is fitted), and the fits of the mounts' laws
     exact_onset: object | None = None
     viscoelastic_fits: tuple[dict, ...] = ()
     practical: PracticalOnset | None = None
@@ -318,8 +319,9 @@ def _undamped_family(model: Model, linearization: str | None, f_fluid: float, fa
 
 def _viscoelastic_check(model: Model, res: CriticalLoad, linearization: str, f_fluid: float, family=None):
     """``(thrust, omega, ExactOnset or None, fits, warnings)``: the onset of the Prony realisation solved
-    again on the exact laws (Newton, :func:`~impstab.linear.viscoelastic.exact_onset`); the exact
-    root is reported when Newton converges to the same root."""
+    again on the exact laws (Newton, :func:`~impstab.linear.viscoelastic.exact_onset`) where a law is
+    fitted (fractional Zener, table); the exact root is reported when Newton converges to the same
+    root. Where every law is its own Prony series there is no fit to check: ``None``."""
     from .viscoelastic import exact_onset
 
     fits = tuple(
@@ -336,6 +338,10 @@ def _viscoelastic_check(model: Model, res: CriticalLoad, linearization: str, f_f
                      "is solved again on the table itself at the onset frequency")
     if res.load is None:
         return None, res.omega, None, fits, tuple(notes)
+    if all(m.viscoelastic.exact_series for m in model.mounts if m.viscoelastic is not None):
+        # standard linear solids and Prony series: the augmented system is the law itself, and its
+        # onset is already the root of the exact eigenproblem (nothing fitted to check)
+        return res.load, res.omega, None, fits, tuple(notes)
     check = exact_onset(model, res.load, res.omega or 0.0, linearization, f_fluid, family)
     if check.exact_thrust is None:
         notes.append("Newton on the exact viscoelastic eigenproblem did not converge at the onset: "
