@@ -57,8 +57,12 @@ class RigidBody:
         return self.inertia_cg - self.mass * (s @ s)
 
     def mass_matrix(self) -> Array:
-        """The 6 x 6 rigid-body mass matrix ``M_RB`` about A (paper eq. 17)."""
-        return rigid_body_mass_matrix(self.mass, self.cg, self.inertia_a)
+        """The 6 x 6 rigid-body mass matrix ``M_RB`` about A (paper eq. 17); a new array each call."""
+        hit = self.__dict__.get("_mass_matrix")
+        if hit is None:  # the body is immutable: formed once
+            hit = _frozen(rigid_body_mass_matrix(self.mass, self.cg, self.inertia_a))
+            object.__setattr__(self, "_mass_matrix", hit)
+        return hit.copy()
 
 
 def rigid_body_mass_matrix(mass: float, cg: Array, inertia_a: Array) -> Array:
