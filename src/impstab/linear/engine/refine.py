@@ -466,7 +466,11 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
     """
     n = jobs.a0.shape[1]
     n_dof = mode_out.shape[1]
-    ws = workspace(n, 1)
+    # counts and flags passed to compiled callees are int64 / bool variables, never literals: numba
+    # compiles a callee once per argument type, and ``Literal[int](0)`` or ``Literal[bool](True)``
+    # (a constant, or a variable's first value while its type is being inferred) is one of its own
+    ws = workspace(n, np.int64(1))
+    with_slope, without_slope = np.bool_(True), np.bool_(False)
     cache = cache_new(n)
     vc = np.empty((n, n), dtype=np.complex128)
     wc = np.empty((n, n), dtype=np.complex128)
@@ -507,7 +511,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
             warned = False
             limit = False
             divergence = False
-            k = 0
+            k = np.int64(0)
             shapes = np.empty((n_dof, 1), dtype=np.complex128)
             values = np.empty(1, dtype=np.complex128)
             vals_r = np.empty(n, dtype=np.complex128)
@@ -618,7 +622,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 if code != OK:
                                     break
                                 f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc,
-                                                      k, divergence, 0.0, True, sel, share, coalesce)
+                                                      k, divergence, 0.0, with_slope, sel, share, coalesce)
                                 if not ok:
                                     break
                                 p, done = newton_step(st, p, f, df)
@@ -640,7 +644,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                     failed = True
                                     break
                                 f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
-                                                     divergence, target, False, sel, share, coalesce)
+                                                     divergence, target, without_slope, sel, share, coalesce)
                                 if code == NOT_FINITE or not ok:
                                     break
                         break
@@ -703,7 +707,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                     failed = True
                     break
                 found, _, divergence = unstable_cluster(cache[2][s], undamped, members, cplx, neg)
-                k = 0
+                k = np.int64(0)
                 for i in range(n):
                     if members[i]:
                         cols[k] = i

@@ -282,7 +282,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
     """
     n = jobs.a0.shape[1]
     count = len(jobs.ints)
-    big_chunk = 1
+    big_chunk = np.int64(1)  # an int64 from the start: workspace compiled for one type (see refine_stack)
     for j in range(count):
         big_chunk = max(big_chunk, jobs.ints[j, CHUNK])
     ws = workspace(n, big_chunk)

@@ -241,7 +241,10 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
         c_status[s] = NOT_FINITE
         vals[:] = np.nan
         return NOT_FINITE, s
-    if n <= MAX_ORDER and block_eig_at(ops[:1], ws[6], 0, 0.0, ws[7], ws[8], ws[9], ws[12], vals, vecs, inv, ws[0]):
+    # the one design of ws[6..9] as an int64, as ``j`` above: numba compiles a callee once per
+    # argument type, and a literal 0 is a type of its own (``Literal[int](0)``)
+    if n <= MAX_ORDER and block_eig_at(ops[:1], ws[6], np.int64(0), 0.0, ws[7], ws[8], ws[9], ws[12], vals, vecs,
+                                       inv, ws[0]):
         c_status[s] = OK
         return OK, s
     c_status[s] = _lapack_vectors(ops[0], vals, vecs, inv)
