@@ -90,10 +90,12 @@ def cluster_participation(shapes: NDArray, values: NDArray, members: NDArray, m_
     m_diag = np.asarray(m_diag, dtype=float)
     n, k = shapes.shape[-2:]
     lead = np.broadcast_shapes(shapes.shape[:-2], values.shape[:-1], members.shape[:-1], m_diag.shape[:-1])
-    flat_s = np.ascontiguousarray(np.broadcast_to(shapes, lead + (n, k)).reshape(-1, n, k))
-    flat_v = np.ascontiguousarray(np.broadcast_to(values, lead + (k,)).reshape(-1, k))
-    flat_m = np.ascontiguousarray(np.broadcast_to(members, lead + (k,)).reshape(-1, k))
-    flat_w = np.ascontiguousarray(np.broadcast_to(m_diag, lead + (n,)).reshape(-1, n))
+    # writable C copies (np.array), as the compiled callers pass: a read-only view of a broadcast
+    # is another argument type, for which numba would compile participation_into again
+    flat_s = np.array(np.broadcast_to(shapes, lead + (n, k)).reshape(-1, n, k), order="C")
+    flat_v = np.array(np.broadcast_to(values, lead + (k,)).reshape(-1, k), order="C")
+    flat_m = np.array(np.broadcast_to(members, lead + (k,)).reshape(-1, k), order="C")
+    flat_w = np.array(np.broadcast_to(m_diag, lead + (n,)).reshape(-1, n), order="C")
     out = np.empty((len(flat_s), n))
     for r in range(len(flat_s)):
         participation_into(flat_s[r], flat_v[r], flat_m[r], flat_w[r], float(tol), out[r])

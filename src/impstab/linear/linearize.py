@@ -210,7 +210,9 @@ class ModelFamily:
     @staticmethod
     def _affine_form(pk: PackedModel, lin: str):
         """``(M, D, K0, K1, G1)`` when K is exactly linear in T, else None (see :func:`affine_forms`)."""
-        stack = lambda a: np.asarray(a, dtype=float)[None]  # noqa: E731
+        # writable copies (np.array): the packed fields may be read-only, another argument type
+        # for numba; the studies and the static mount loads pass writable arrays to the same kernel
+        stack = lambda a: np.array(a, dtype=float)[None]  # noqa: E731
         m, d, k0, k1, g1, affine = affine_forms(
             stack(pk.mass6), stack(pk.damp6), stack(pk.positions), stack(pk.stiffness), stack(pk.damping),
             stack(pk.e_dir), stack(pk.r_thrust), stack(pk.tangency), pk.preload, stack(pk.length_scale),

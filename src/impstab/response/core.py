@@ -175,12 +175,15 @@ def harmonic_response(
     km = c(mount_stiffness)
     cm = c(mount_damping)
     nm = km.shape[1]
-    extra = np.zeros((nd, 0, 6, 6), dtype=complex) if fluid is None else c(np.broadcast_to(fluid, (nd, nf, 6, 6)), complex)
+    # broadcasts copied (np.array, C order), not viewed: a read-only view is another argument
+    # type, for which numba would compile the kernels below again
+    extra = (np.zeros((nd, 0, 6, 6), dtype=complex) if fluid is None
+             else np.array(np.broadcast_to(fluid, (nd, nf, 6, 6)), complex, order="C"))
     hull = np.zeros((1, 0, nm), dtype=complex)
     if foundation is not None and not np.all(np.isinf(foundation)):
         hull = np.asarray(foundation, dtype=complex)
         hull = hull.reshape((1,) * (3 - hull.ndim) + hull.shape)        # (nf, nm) -> (1, nf, nm)
-        hull = c(np.broadcast_to(hull, (hull.shape[0], nf, nm)), complex)
+        hull = np.array(np.broadcast_to(hull, (hull.shape[0], nf, nm)), complex, order="C")
     loads = np.asarray(loads, dtype=complex)
     loads = loads.reshape((1,) * (3 - loads.ndim) + loads.shape)        # (6,) or (nf, 6) -> (1, ., 6)
     if fluid_damping is None:
@@ -188,7 +191,7 @@ def harmonic_response(
         scale = np.abs(np.asarray(damping, float)).max(axis=(-2, -1), keepdims=True)
         d_fluid = np.where(np.abs(d_fluid) <= 1e-12 * scale, 0.0, d_fluid)
     else:
-        d_fluid = np.broadcast_to(np.asarray(fluid_damping, float), (nd, 6, 6))
+        d_fluid = np.array(np.broadcast_to(np.asarray(fluid_damping, float), (nd, 6, 6)), order="C")  # as above
     q, pivot = solve_harmonic(
         c(mass), c(np.asarray(damping, float) + np.asarray(gyroscopic, float)), k, w, c(loads, complex), extra, b, km, cm, hull
     )

@@ -184,7 +184,8 @@ def static_mount_loads(model: Model, thrust: float | None = None, linearization:
                 load[0, i, :3] += law_gradient(np.ascontiguousarray(m.nonlinear.packed()[None]), 0, *e[0, i, :3])
     else:
         pk = pack_model(model)
-        stack = lambda a: np.asarray(a, dtype=float)[None]  # noqa: E731
+        # writable copies, as ModelFamily passes them (a read-only field is another type for numba)
+        stack = lambda a: np.array(a, dtype=float)[None]  # noqa: E731
         q1 = classical_forms(stack(pk.mass6), stack(pk.damp6), stack(pk.positions), stack(pk.stiffness),
                              stack(pk.damping), stack(pk.e_dir), stack(pk.r_thrust), stack(pk.tangency), pk.preload)[5]
         q0 = t * q1

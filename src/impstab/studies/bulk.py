@@ -160,7 +160,10 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
     if len(good) < n:
         positions, stiffness, length_scale = positions[good], stiffness[good], length_scale[good]
     n_good = len(good)
-    rep = lambda a: np.broadcast_to(np.asarray(a, dtype=float), (n_good, *np.shape(a)))  # noqa: E731
+    # the shared fields repeated as writable C arrays (np.array copies), as a single design passes
+    # them (ModelFamily): a read-only broadcast view is another argument type, for which numba
+    # would compile classical_forms again
+    rep = lambda a: np.array(np.broadcast_to(np.asarray(a, dtype=float), (n_good, *np.shape(a))), order="C")  # noqa: E731
     mass, _, k0, k1, _, affine = affine_forms(
         rep(pk.mass6), rep(pk.damp6), positions, stiffness, rep(np.zeros(stiffness.shape[1:])), rep(pk.e_dir),
         rep(pk.r_thrust), np.full(n_good, pk.tangency), pk.preload, length_scale,
