@@ -176,9 +176,12 @@ def _counts() -> tuple[int, int]:
     return compiled, loaded
 
 
-#: expected compile work of each command's cases after the first case (which compiles the
-#: linear kernels every command shares): the larger go first to the parallel workers
-_WEIGHT = {"sweep": 3, "simulate": 2, "response": 2}
+#: expected compile work (seconds, measured on two cores) of each command's cases after the first
+#: case, which compiles the linear kernels every command shares (every command computes the
+#: critical thrust). The larger go first to the parallel workers, each to the first one free (the
+#: longest-first rule): the time integrators' kernels, the studies' bulk paths, the periodic orbits'
+#: complex-step Jacobian, the harmonic solver; the other commands reuse what the first case compiled
+_WEIGHT = {"simulate": 40, "sweep": 20, "postcritical": 15, "response": 8}
 
 
 def _run(numbered: list[tuple[int, str, list[str]]], total: int, quiet: bool) -> list[tuple[str, str]]:
