@@ -231,3 +231,36 @@ def test_precompile_stops_at_a_complete_cache_and_keeps_the_users_own(tmp_path, 
     assert "already compiled" in capsys.readouterr().out
     assert precompile.main(["--clean"]) == 0
     assert "not removed" in capsys.readouterr().out and (own / precompile.MARKER).is_file()
+
+
+def test_concurrent_cache_saves_of_one_kernel_keep_every_signature(tmp_path, monkeypatch):
+    """numba's cache index update (read, choose a free data file, write) under impstab's lock:
+    eight writers saving different signatures of one kernel at once, each pausing between reading
+    the index and writing it back, leave eight index entries, each naming its own data. Without
+    the lock they choose the same data file and entries are lost (checked)."""
+    import threading
+    import time
+
+    from numba.core import caching
+
+    from impstab._numba_cache import lock_cache_files
+
+    lock_cache_files()
+    read_index = caching.IndexDataCacheFile._load_index
+
+    def slow_read(self):
+        out = read_index(self)
+        time.sleep(0.02)  # another writer reads the same index meanwhile
+        return out
+
+    monkeypatch.setattr(caching.IndexDataCacheFile, "_load_index", slow_read)
+    files = [caching.IndexDataCacheFile(str(tmp_path), "kernel-1", ("stamp", 1)) for _ in range(8)]
+    threads = [threading.Thread(target=f.save, args=((f"signature {i}",), f"machine code {i}"))
+               for i, f in enumerate(files)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    index = caching.IndexDataCacheFile(str(tmp_path), "kernel-1", ("stamp", 1))
+    for i in range(8):
+        assert index.load((f"signature {i}",)) == f"machine code {i}"

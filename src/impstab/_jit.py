@@ -193,6 +193,9 @@ def require_compiled(force: bool = False) -> None:
             return
         import numba
 
+        from ._numba_cache import lock_cache_files
+
+        lock_cache_files()  # processes compiling into one cache at once (make compile, test workers)
         for hook in _hooks:
             hook()
         for kernel in _kernels:

@@ -21,17 +21,28 @@ elsewhere (commands, drawing, docs) keep it. ``make clean-cache`` removes every 
 The hook costs nothing until numba is imported: :func:`install` puts a finder in front of
 ``sys.meta_path`` that computes the folder (a few milliseconds) when the first ``import numba``
 happens and then steps aside.
+
+Processes sharing a cache. numba adds a compiled signature to a kernel's cache by reading its
+index, choosing the next free data file and writing both back, with no lock between processes
+(``make compile`` runs its cases in parallel processes, the test suite in several workers). Two
+processes saving different signatures of one kernel at once can then both choose the same data
+file: one index entry is lost, or, worse, an entry names the other signature's machine code.
+:func:`lock_cache_files` (called when a process compiles) makes each kernel's index and data
+update one step under an exclusive ``flock`` on a lock file beside the index, and each load
+read them under a shared one (POSIX; elsewhere numba's own behaviour stays).
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import re
 import sys
 from pathlib import Path
 
-__all__ = ["install", "cache_dir", "cache_root", "kernel_sources", "source_key", "is_kernel_module", "user_setting", "ENV"]
+__all__ = ["install", "cache_dir", "cache_root", "kernel_sources", "source_key", "is_kernel_module", "user_setting",
+           "lock_cache_files", "ENV"]
 
 #: numba's own setting (read once, when numba is imported)
 ENV = "NUMBA_CACHE_DIR"
@@ -165,6 +176,41 @@ def install() -> None:
         _configure()
     elif _BeforeNumba not in sys.meta_path:
         sys.meta_path.insert(0, _BeforeNumba)  # type: ignore[arg-type]
+
+
+def lock_cache_files() -> None:
+    """Serialise numba's cache updates of each kernel across processes (see the module notes).
+
+    Wraps ``numba.core.caching.IndexDataCacheFile.save`` (exclusive lock) and ``load`` (shared
+    lock) once per process; where ``fcntl`` or that class is missing, or the lock file cannot be
+    opened (a read-only cache, which numba does not write either), numba runs unchanged.
+    """
+    try:
+        import fcntl
+        from numba.core import caching
+    except ImportError:  # pragma: no cover - not POSIX, or a numba without that module
+        return
+    cls = getattr(caching, "IndexDataCacheFile", None)
+    if cls is None or getattr(cls, "_impstab_locked", False) or not hasattr(cls, "save"):
+        return
+
+    def locked(method, mode):
+        @functools.wraps(method)
+        def run(self, *args, **kwargs):
+            try:
+                fd = os.open(str(self._index_path) + ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+            except (OSError, AttributeError):
+                return method(self, *args, **kwargs)
+            try:
+                fcntl.flock(fd, mode)
+                return method(self, *args, **kwargs)
+            finally:
+                os.close(fd)  # releases the lock
+        return run
+
+    cls.save = locked(cls.save, fcntl.LOCK_EX)
+    cls.load = locked(cls.load, fcntl.LOCK_SH)
+    cls._impstab_locked = True
 
 
 def remove() -> None:
