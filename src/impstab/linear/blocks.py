@@ -413,9 +413,8 @@ def block_eig_at(a0, a1, s, p, order, starts, nblocks, mirror, vals, vecs, inv, 
             i, j = order[s, lo], order[s, lo + 1]
             a, bb, c, d = w0[0, 0], w0[0, 1], w0[1, 0], w0[1, 1]
             l1, l2 = _values2(a, bb, c, d)
-            # bool variables, not literals: numba would compile _vector2 once for each literal
-            v00, v10 = _vector2(l1, a, bb, c, d, np.bool_(True))
-            v01, v11 = _vector2(l2, a, bb, c, d, np.bool_(False))
+            v00, v10 = _vector2(l1, a, bb, c, d, True)
+            v01, v11 = _vector2(l2, a, bb, c, d, False)
             det = v00 * v11 - v01 * v10
             if det == 0.0 or not (np.isfinite(det.real) and np.isfinite(det.imag)):
                 good = False

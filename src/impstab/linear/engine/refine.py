@@ -471,7 +471,6 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
     # (a constant, or a variable's first value while its type is being inferred) is one of its own
     ws = workspace(n, np.int64(1))
     with_slope, without_slope = np.bool_(True), np.bool_(False)
-    decompose, values_only = np.bool_(True), np.bool_(False)  # spectrum's ``vectors``
     cache = cache_new(n)
     vc = np.empty((n, n), dtype=np.complex128)
     wc = np.empty((n, n), dtype=np.complex128)
@@ -522,7 +521,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
             steps = 0 if start_unstable else 200
             for _ in range(steps):
                 point[0] = b
-                code_b, sb = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                code_b, sb = spectrum(jobs, j, point, True, cache, ws, ev)
                 if code_b == PROVIDER_ERROR:
                     failed = True
                     break
@@ -533,7 +532,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         limit = True
                         break
                     point[0] = mid
-                    if spectrum(jobs, j, point, values_only, cache, ws, ev)[0] == PROVIDER_ERROR:
+                    if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
                         failed = True
                         break
                     _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
@@ -547,7 +546,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 if found and code_b == OK:
                     k = projector(cache[3][sb], cache[4][sb], members, vc, wc)
                     point[0] = a
-                    code_a, sa = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                    code_a, sa = spectrum(jobs, j, point, True, cache, ws, ev)
                     if code_a == PROVIDER_ERROR:
                         failed = True
                         break
@@ -562,7 +561,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                             marginal = True
                             for p in (a, min(max(a + (a - b), lo_lim), hi_lim)):
                                 point[0] = p
-                                code, s = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
@@ -590,7 +589,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         clear = True
                         for e in range(2):
                             point[0] = a if e == 0 else b
-                            code, s = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                            code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                             if code == PROVIDER_ERROR:
                                 failed = True
                                 break
@@ -616,7 +615,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                             p = hermite_root(a, b, fa, fb, dfab[0], dfab[1])
                             for _ in range(100):
                                 point[0] = last = p
-                                code, s = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
@@ -640,7 +639,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                     root = x
                                     break
                                 point[0] = last = x
-                                code, s = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
@@ -655,7 +654,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         # the onset values: cluster at the root (or at the last point evaluated, where
                         # that is within 1e-12 of it), distinct modes at a (stable side)
                         point[0] = last if abs(root - last) <= 1e-12 * abs(root) else root
-                        code, s = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                        code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
@@ -664,7 +663,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
                         vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
                         point[0] = a
-                        code, s = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                        code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
@@ -681,7 +680,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 if mid == a or mid == b:
                     break
                 point[0] = mid
-                if spectrum(jobs, j, point, values_only, cache, ws, ev)[0] == PROVIDER_ERROR:
+                if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
                     failed = True
                     break
                 _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
@@ -703,7 +702,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 coalesce = False
                 root = b
                 point[0] = b
-                code, s = spectrum(jobs, j, point, decompose, cache, ws, ev)
+                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                 if code == PROVIDER_ERROR:
                     failed = True
                     break

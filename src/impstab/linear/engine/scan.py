@@ -282,11 +282,10 @@ def scan_stack(jobs, all_crossings, onsets, counts):
     """
     n = jobs.a0.shape[1]
     count = len(jobs.ints)
-    big_chunk = np.int64(1)  # int64 and bool variables for the callees, not literals (see refine_stack)
+    big_chunk = np.int64(1)  # an int64 from the start: workspace compiled for one type (see refine_stack)
     for j in range(count):
         big_chunk = max(big_chunk, jobs.ints[j, CHUNK])
     ws = workspace(n, big_chunk)
-    decompose, values_only = np.bool_(True), np.bool_(False)  # spectrum's ``vectors``
     cache = cache_new(n)
     npts_max = jobs.grids.shape[1]
     flags = np.zeros(npts_max, dtype=np.bool_)
@@ -322,7 +321,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                     break  # a change, or unstable at jj: the next point is not needed
                 while known < need:  # classify the next chunk
                     stop = min(known + chunk, npts)
-                    code, _ = spectrum(jobs, j, grid[known:stop], values_only, cache, ws, counter)
+                    code, _ = spectrum(jobs, j, grid[known:stop], False, cache, ws, counter)
                     if code == PROVIDER_ERROR:
                         failed = True
                         break
@@ -373,7 +372,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                                 counter[0] += 1
                                 counter[2] += 1
                             if pull < 0:  # repeated eigenvalues, or no inverse iteration: decompose
-                                code, s = spectrum(jobs, j, grid[jj:jj + 1], decompose, cache, ws, counter)
+                                code, s = spectrum(jobs, j, grid[jj:jj + 1], True, cache, ws, counter)
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
@@ -389,7 +388,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                     probe[0] = fmin_start(st, grid[jj - 1], grid[jj + 1], (grid[jj + 1] - grid[jj - 1]) * 1e-9)
                     more = True
                     while more:
-                        code, _ = spectrum(jobs, j, probe, values_only, cache, ws, counter)
+                        code, _ = spectrum(jobs, j, probe, False, cache, ws, counter)
                         if code == PROVIDER_ERROR:
                             failed = True
                             break

@@ -19,11 +19,9 @@ routines cannot resolve (no convergence, a defective block), go to LAPACK throug
 
 :func:`spectrum` is the one entry point of the scan and the refinement (numba links a
 function's callees into it and optimises them again, so the engine keeps a single function
-above these routines; its callers pass ``vectors`` as a bool variable, since a literal
-``True`` or ``False`` is a type of its own, for which numba would compile it once each).
-Decompositions are kept in a small cache (least recently used) per problem. A provider that
-raises stops its own problem only: the exception is kept on the provider and the problem
-reports :data:`PROVIDER_ERROR`.
+above these routines). Decompositions are kept in a small cache (least recently used) per
+problem. A provider that raises stops its own problem only: the exception is kept on the
+provider and the problem reports :data:`PROVIDER_ERROR`.
 """
 
 from __future__ import annotations
