@@ -80,10 +80,6 @@ def fastest_mode(lin, model: Model | None = None) -> tuple[float, str]:
     return omega, mode
 
 
-def _has_beams(model: Model) -> bool:
-    return any(m.is_massive_beam for m in model.mounts)
-
-
 def _fastest(model: Model, lin) -> tuple[float, str, float]:
     """``(omega (rad/s), dominant dof, rate (1/s))``: the fastest mode of ``lin`` (snubbers in
     contact included, :func:`fastest_mode`), with massive beam mounts of the body with the
@@ -91,7 +87,7 @@ def _fastest(model: Model, lin) -> tuple[float, str, float]:
     viscoelastic mounts, of the augmented system with their internal variables, and its fastest
     real relaxation root (0 without)."""
     omega, mode = fastest_mode(lin, model)
-    if _has_beams(model):
+    if model.has_massive_beams:
         beam = fastest_root(model, lin.thrust)
         if beam.omega > omega:
             omega, mode = beam.omega, beam.mode
@@ -126,7 +122,7 @@ def check_step(model: Model, thrust: float, integrator: str, dt: float | None, n
     mounts at constant thrust ``thrust`` (N), before a run
     (:func:`~impstab.dynamics.viscoelastic.check_explicit_step`,
     :func:`~impstab.dynamics.beam_mounts.check_beam_step`); ``names`` as :func:`check_work`."""
-    beams = _has_beams(model)
+    beams = model.has_massive_beams
     if dt is None or not (model.is_viscoelastic or beams) or not get_integrator(integrator).fixed_step:
         return
     omega, _, rate = _fastest(model, linearize(model, float(thrust), "equilibrium"))
@@ -173,7 +169,7 @@ def check_work(model: Model, step_sizes: list[float], duration: float, dt: float
         raise ModelError(field, dt if dt is not None else duration,
                          f"would need {describe_count(total)} time steps (limit {describe_count(limit)}){hint}")
     internal = 3 * sum(m.viscoelastic.n_terms for m in model.mounts if m.viscoelastic is not None)
-    if _has_beams(model):
+    if model.has_massive_beams:
         internal += 2 * beam_dofs(model).n
     per_sample = 8 * 2 * (15 + 6 * len(model.mounts) + internal)
     samples = sum(math.ceil(duration / sample) if sample is not None else min(math.ceil(duration / h), MAX_SAMPLES)

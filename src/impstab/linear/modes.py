@@ -289,7 +289,7 @@ def modes(model: Model, thrust: float = 0.0, linearization: str | None = None) -
         from .viscoelastic import viscoelastic_modes
 
         return viscoelastic_modes(model, thrust, linearization)
-    if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: the grown system
+    if model.has_massive_beams:  # internal mount dofs: the grown system
         grown = _grown_modes(model, thrust, linearization)
         if not model.fluid.compressible:
             return grown
@@ -394,7 +394,7 @@ def body_modes(model: Model, thrust: float, linearization: str, vals, vecs, m) -
     kinetic energy."""
     extra = {}
     nq = m.shape[0]
-    if any(mt.is_massive_beam for mt in model.mounts):
+    if model.has_massive_beams:
         energy = (vecs.conj() * (m @ vecs)).real                 # (nq, k)
         total = energy.sum(axis=0)
         internal = np.clip(energy[6:].sum(axis=0) / np.where(total > 0, total, 1.0), 0.0, 1.0)  # rounding: no -0.0

@@ -106,6 +106,12 @@ class Model:
         return any(np.any(m.damping != 0) for m in self.mounts) or self.is_viscoelastic
 
     @property
+    def has_massive_beams(self) -> bool:
+        """True when a mount is a beam with mass (internal dofs in the linear analyses, kept modes
+        in the time histories)."""
+        return any(m.is_massive_beam for m in self.mounts)
+
+    @property
     def is_viscoelastic(self) -> bool:
         """True when a mount carries a viscoelastic law (internal variables in the linear analyses)."""
         return any(m.viscoelastic is not None for m in self.mounts)

@@ -116,7 +116,7 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
         return None
     if model.is_nonlinear or model.analysis.min_damping_ratio is not None:  # the practical onset: per model
         return None
-    if any(m.is_massive_beam for m in model.mounts):  # internal mount dofs: per-variant path
+    if model.has_massive_beams:  # internal mount dofs: per-variant path
         return None
     for seg in segments:
         if seg[0] == "mounts" and seg[2] in ("k_axial", "k_shear") and doc.mounts[seg[1]].stiffness is not None:
