@@ -592,7 +592,7 @@ def _degeneracy(jac, mass, spec: Spectrum, idx, lam, kappa, dlam, scale, states=
                 "not apply"), null
     if not math.isfinite(dlam.real):
         return "the crossing speed d sigma/dp is not finite", 1
-    if abs(dlam.real) <= TRANSVERSALITY_TOLERANCE * max(speed, 1e-300):
+    if not crossing:
         if symmetric_spectrum:
             return ("reversible / undamped: the pair stays on the imaginary axis (d sigma/dp = 0, spectrum symmetric "
                     "about the axis): no crossing, a conservative family of oscillations, no isolated attracting "
