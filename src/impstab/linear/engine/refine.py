@@ -466,9 +466,11 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
     """
     n = jobs.a0.shape[1]
     n_dof = mode_out.shape[1]
-    # counts and flags passed to compiled callees are int64 / bool variables, never literals: numba
+    # counts and flags passed to compiled callees are int64 / bool variables, not literals: numba
     # compiles a callee once per argument type, and ``Literal[int](0)`` or ``Literal[bool](True)``
-    # (a constant, or a variable's first value while its type is being inferred) is one of its own
+    # (a constant, or a variable's first value while its type is being inferred) is one of its own.
+    # Except ``spectrum``'s ``vectors``: one specialisation per value, each without the other branch,
+    # is what its every-eigenproblem calls want
     ws = workspace(n, np.int64(1))
     with_slope, without_slope = np.bool_(True), np.bool_(False)
     cache = cache_new(n)
