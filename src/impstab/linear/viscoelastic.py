@@ -49,39 +49,67 @@ CLUSTER = 1e-8
 NEWTON_FLOOR = 1e-9
 
 
-def _terms(model: Model):
-    """``(mount index, static 3x3 k, g (n,), tau (n,))`` of every viscoelastic mount."""
-    out = []
-    for i, m in enumerate(model.mounts):
-        if m.viscoelastic is not None:
-            out.append((i, np.array(m.stiffness[:3, :3]), m.viscoelastic.weights, m.viscoelastic.relaxation_times))
-    return out
+@dataclass(frozen=True, eq=False)
+class _Terms:
+    """The Prony terms of a model's viscoelastic mounts and what the assembly derives from them once.
+
+    Iterating gives ``(mount index, static 3x3 k, g (n,), tau (n,))`` per viscoelastic mount.
+    ``groups``: ``(tau, positions in the mounts' order, g of each)`` of the terms that share a
+    relaxation time; ``weights``: each mount's ``sum g``; ``group_weights (groups, v)``: the g of
+    every mount in each group (zero where a mount has no term at that tau).
+    """
+
+    entries: tuple
+    mounts: list[int]
+    k: Array
+    weights: Array
+    groups: tuple
+    group_weights: Array
+
+    @classmethod
+    def of(cls, model: Model) -> "_Terms":
+        entries = tuple((i, np.array(m.stiffness[:3, :3]), m.viscoelastic.weights, m.viscoelastic.relaxation_times)
+                        for i, m in enumerate(model.mounts) if m.viscoelastic is not None)
+        by_tau: dict[float, dict[int, float]] = {}  # tau -> {position of the mount: its g at tau}
+        for j, (_, _, g, tau) in enumerate(entries):
+            for gj, tj in zip(g.tolist(), tau.tolist()):
+                members = by_tau.setdefault(tj, {})
+                members[j] = members.get(j, 0.0) + gj
+        groups = tuple((tj, tuple(members), np.array(list(members.values()))) for tj, members in by_tau.items())
+        return cls(entries, [e[0] for e in entries], np.array([e[1] for e in entries]).reshape(-1, 3, 3),
+                   np.array([sum(e[2].tolist()) for e in entries]), groups,
+                   np.array([[members.get(j, 0.0) for j in range(len(entries))] for members in by_tau.values()])
+                   .reshape(len(groups), len(entries)))
+
+    def __iter__(self):
+        return iter(self.entries)
+
+    def __len__(self) -> int:
+        return len(self.entries)
+
+    def __getitem__(self, j):
+        return self.entries[j]
 
 
-def _groups(terms) -> dict[float, list]:
-    """``{tau: [(position in terms, g), ...]}``: the Prony terms that share a relaxation time."""
-    groups: dict[float, list] = {}
-    for j, (_, _, g, tau) in enumerate(terms):
-        for gj, tj in zip(g, tau):
-            groups.setdefault(float(tj), []).append((j, float(gj)))
-    return groups
+def _terms(model: Model) -> _Terms:
+    """The Prony terms of every viscoelastic mount (:class:`_Terms`)."""
+    return _Terms.of(model)
 
 
-def _mount_maps(rho: Array, terms) -> tuple[Array, Array, Array]:
+def _mount_maps(rho: Array, terms: _Terms) -> tuple[Array, Array, Array]:
     """For the viscoelastic mounts (in the order of ``terms``) at arms ``rho (..., nm, 3)``: their maps
     ``B_i (..., v, 3, 6)``, ``B_i^T k_i (..., v, 6, 3)`` and ``B_i^T k_i B_i (..., v, 6, 6)``."""
-    maps = rigid_map(rho[..., [i for i, _, _, _ in terms], :])
-    btk = np.swapaxes(maps, -1, -2) @ np.stack([km for _, km, _, _ in terms])
+    maps = rigid_map(rho[..., terms.mounts, :])
+    btk = np.swapaxes(maps, -1, -2) @ terms.k
     return maps, btk, btk @ maps
 
 
-def _reduced_ranks(maps: Array, terms) -> dict[float, int]:
+def _reduced_ranks(maps: Array, terms: _Terms) -> dict[float, int]:
     """Rank of the stacked maps ``B`` of each relaxation time's mounts (at most 6; the same at every
     thrust: the equilibrium only rotates the arms), from the maps ``(v, 3, 6)`` of :func:`_mount_maps`."""
     ranks: dict[float, int] = {}
     by_mounts: dict[tuple, int] = {}  # relaxation times of the same mounts share the rank
-    for tj, members in _groups(terms).items():
-        js = tuple(j for j, _ in members)
+    for tj, js, _ in terms.groups:
         if js not in by_mounts:
             sv = np.linalg.svd(maps[list(js)].reshape(-1, 6), compute_uv=False)
             by_mounts[js] = int((sv > 1e-12 * sv[0]).sum())
@@ -111,52 +139,47 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
     (:func:`_reduced_ranks`), where known; otherwise from the first stack with finite arms.
     ``maps``: :func:`_mount_maps` of ``rho`` where already known.
     """
-    s = m.shape[0]
+    s, nq = m.shape[0], m.shape[-1]  # nq: 6, or 6 + the internal dofs of massive beam mounts (the body's first)
     maps, btk, stiff = _mount_maps(rho, terms) if maps is None else maps  # (S, v, 3, 6), (S, v, 6, 3), (S, v, 6, 6)
-    weights = np.zeros(len(terms))
-    blocks = []   # (rows from q (S, r, 6), force columns (S, 6, r), tau)
+    flat = stiff.reshape(s, len(terms), 36)
+    blocks = []   # (rows from q (S, r, 6), or None for q itself; force columns (S, 6, r); tau)
     if reduced:
-        eye = np.broadcast_to(np.eye(6), (s, 6, 6))
         if ranks is None:  # invariant under the rotation of the arms: from the first finite stack
             ranks = _reduced_ranks(maps[int(np.argmax(np.isfinite(maps).all(axis=(1, 2, 3))))], terms)
-        for tj, members in _groups(terms).items():
-            js = [j for j, _ in members]
-            gs = np.array([gj for _, gj in members])
-            for j, gj in members:
-                weights[j] += gj
-            rank = ranks[tj]
-            if rank == 6:
-                blocks.append((eye, np.einsum("v,svab->sab", gs, stiff[:, js]), tj))
+        forces = (terms.group_weights @ flat).reshape(s, -1, 6, 6)  # K_tau of each group
+        for g, (tj, js, gs) in enumerate(terms.groups):
+            if ranks[tj] == 6:
+                blocks.append((None, forces[:, g], tj))
                 continue
-            b = maps[:, js].reshape(s, -1, 6)                                              # (S, 3m, 6)
-            cols = np.concatenate(list(gs[:, None, None, None] * np.swapaxes(btk[:, js], 0, 1)), axis=2)  # (S, 6, 3m)
-            u = np.linalg.svd(np.where(np.isfinite(b), b, 0.0))[0][:, :, :rank]
+            b = maps[:, list(js)].reshape(s, -1, 6)                                        # (S, 3m, 6)
+            cols = np.concatenate(list(gs[:, None, None, None] * np.swapaxes(btk[:, list(js)], 0, 1)), axis=2)  # (S, 6, 3m)
+            u = np.linalg.svd(np.where(np.isfinite(b), b, 0.0))[0][:, :, :ranks[tj]]
             blocks.append((np.swapaxes(u, -1, -2) @ b, cols @ u, tj))
     else:
         for j, (_, _, g, tau) in enumerate(terms):
-            weights[j] = float(np.sum(g))
             for gj, tj in zip(g, tau):
                 blocks.append((maps[:, j], gj * btk[:, j], float(tj)))
-    nq = m.shape[-1]  # 6, or 6 + the internal dofs of massive beam mounts (the body's dofs first)
-    kk = np.array(k, dtype=float)
-    kk[:, :6, :6] += np.einsum("v,svab->sab", weights, stiff)
-    nz = sum(blk[0].shape[1] for blk in blocks)
-    n = 2 * nq + nz
+    n = 2 * nq + sum(force.shape[-1] for _, force, _ in blocks)
     e = np.zeros((s, n, n))
     a = np.zeros((s, n, n))
-    e[:, :nq, :nq] = np.eye(nq)
+    e.reshape(s, n * n)[:, :: n + 1] = 1.0
     e[:, nq:2 * nq, nq:2 * nq] = m
-    e[:, 2 * nq:, 2 * nq:] = np.eye(nz)
-    a[:, :nq, nq:2 * nq] = np.eye(nq)
+    dof = np.arange(nq)
+    a[:, dof, nq + dof] = 1.0
     a[:, nq:2 * nq, nq:2 * nq] = -c
+    a[:, nq:2 * nq, :nq] = -np.asarray(k, dtype=float)
+    a[:, nq:nq + 6, :6] -= (terms.weights @ flat).reshape(s, 6, 6)  # the static stiffness of the mounts
     row = 2 * nq
     for from_q, force, tj in blocks:
-        r = from_q.shape[1]
+        r = force.shape[-1]
+        own = row + np.arange(r)
         a[:, nq:nq + 6, row:row + r] = force
-        a[:, row:row + r, :6] = from_q / tj
-        a[:, row:row + r, row:row + r] = -np.eye(r) / tj
+        if from_q is None:
+            a[:, own, dof[:6]] = 1.0 / tj
+        else:
+            a[:, row:row + r, :6] = from_q / tj
+        a[:, own, own] = -1.0 / tj
         row += r
-    a[:, nq:2 * nq, :nq] = -kk
     return e, a
 
 
