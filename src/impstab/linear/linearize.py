@@ -71,7 +71,8 @@ def pack_model(model: Model, damped: bool = True, fluid_frequency: float = 0.0) 
     damping = np.array([m.damping for m in model.mounts], dtype=float).reshape(-1, 6, 6)
     if not damped:
         damping = np.zeros_like(damping)
-    arms = np.concatenate([np.linalg.norm(positions, axis=1), [np.linalg.norm(model.thrust.point)]])
+    point = np.asarray(model.thrust.point, dtype=float)
+    arm = float(np.sqrt(max((positions * positions).sum(axis=1).max(initial=0.0), point @ point)))  # the longest arm (m)
     laws = np.zeros((len(model.mounts), N_LAW))
     for i, mount in enumerate(model.mounts):
         if mount.is_nonlinear:
@@ -83,14 +84,14 @@ def pack_model(model: Model, damped: bool = True, fluid_frequency: float = 0.0) 
         stiffness=np.ascontiguousarray(stiffness),
         damping=np.ascontiguousarray(damping),
         e_dir=np.ascontiguousarray(model.thrust.direction),
-        r_thrust=np.ascontiguousarray(model.thrust.point, dtype=float),
+        r_thrust=np.ascontiguousarray(point),
         tangency=float(model.thrust.tangency),
         preload=bool(model.thrust.preload_stiffness),
         polar_inertia=float(model.propeller.polar_inertia),
         speed=float(model.propeller.speed),
         speed_law=model.propeller.speed_law,
         operating=model.thrust.operating,
-        length_scale=float(max(arms.max(initial=0.0), 1e-3)),
+        length_scale=max(arm, 1e-3),
         laws=laws,
     )
 
@@ -124,10 +125,10 @@ def affine_forms(
     )
     affine = np.ones(len(m), dtype=bool)
     if equilibrium:
-        rot = np.abs(q0[:, 3:]).max(axis=-1) * length_scale
-        size = np.maximum(np.abs(q0[:, :3]).max(axis=-1), 1e-300)
-        affine = rot <= 1e-13 * size
-        if laws is not None and np.any(laws[..., LAW_K3_AXIAL:] != 0.0):
+        aq = np.abs(q0)
+        size = np.maximum(aq[:, :3].max(axis=-1), 1e-300)
+        affine = aq[:, 3:].max(axis=-1) * length_scale <= 1e-13 * size
+        if laws is not None and laws[..., LAW_K3_AXIAL:].any():
             u1 = q0[:, None, :3]
             axis = laws[..., LAW_AXIS:LAW_AXIS + 3]
             along = (axis * u1).sum(axis=-1)

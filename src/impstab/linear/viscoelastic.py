@@ -164,23 +164,27 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
     a = np.zeros((s, n, n))
     e.reshape(s, n * n)[:, :: n + 1] = 1.0
     e[:, nq:2 * nq, nq:2 * nq] = m
-    dof = np.arange(nq)
-    a[:, dof, nq + dof] = 1.0
+    _diagonal(a, 0, nq, nq)[...] = 1.0
     a[:, nq:2 * nq, nq:2 * nq] = -c
     a[:, nq:2 * nq, :nq] = -np.asarray(k, dtype=float)
     a[:, nq:nq + 6, :6] -= (terms.weights @ flat).reshape(s, 6, 6)  # the static stiffness of the mounts
     row = 2 * nq
     for from_q, force, tj in blocks:
         r = force.shape[-1]
-        own = row + np.arange(r)
         a[:, nq:nq + 6, row:row + r] = force
         if from_q is None:
-            a[:, own, dof[:6]] = 1.0 / tj
+            _diagonal(a, row, 0, 6)[...] = 1.0 / tj
         else:
             a[:, row:row + r, :6] = from_q / tj
-        a[:, own, own] = -1.0 / tj
+        _diagonal(a, row, row, r)[...] = -1.0 / tj
         row += r
     return e, a
+
+
+def _diagonal(x: Array, row: int, col: int, r: int) -> Array:
+    """A view of the entries ``x[:, row + i, col + i]``, ``i < r``, of a C-contiguous stack ``x (S, n, n)``."""
+    n = x.shape[-1]
+    return x.reshape(x.shape[0], n * n)[:, row * n + col:: n + 1][:, :r]
 
 
 def dynamic_stiffness(lam: complex, m, c, k, rho, model: Model, exact: bool = True) -> Array:

@@ -103,7 +103,7 @@ class Model:
     @property
     def is_damped(self) -> bool:
         """True when a mount has a damper or a viscoelastic law (which dissipates too)."""
-        return any(np.any(m.damping != 0) for m in self.mounts) or self.is_viscoelastic
+        return self.is_viscoelastic or any(m.damping.any() for m in self.mounts)
 
     @property
     def has_massive_beams(self) -> bool:

@@ -88,22 +88,46 @@ class Problem:
 
 @njit(cache=True, error_model="numpy")
 def _solve_into(m, rhs, out):
-    """``out[s, r] = m[s]^-1 rhs[s, r]`` by LU with partial pivoting; False where an ``m[s]`` is singular."""
+    """``out[s, r] = m[s]^-1 rhs[s, r]`` by LU with partial pivoting; False where an ``m[s]`` is singular.
+
+    Only the band of rows from the first to the last that differ from the identity's is solved:
+    with those rows ``b``, ``m = [[I, 0, 0], [m_b0, m_bb, m_b2], [0, 0, I]]`` and the solution keeps
+    ``rhs``'s other rows, with ``m_bb^-1 (rhs_b - m_b0 rhs_0 - m_b2 rhs_2)`` on the band, exactly
+    (an augmented state's ``E = diag(I, M, I)``: a system of the order of ``M``; a mass matrix is one
+    band, all of it).
+    """
     count, n = m.shape[0], m.shape[1]
     b = np.empty((n, n))
     piv = np.empty(n, dtype=np.int64)
     x = np.empty(n)
     for s in range(count):
-        b[:, :] = m[s]
-        if _lu(b, n, piv, 0.0):
+        r0, r1 = n, 0
+        for i in range(n):
+            for j in range(n):
+                if m[s, i, j] != (1.0 if i == j else 0.0):
+                    r0 = min(r0, i)
+                    r1 = i + 1
+                    break
+        k = max(r1 - r0, 0)
+        for i in range(k):
+            for j in range(k):
+                b[i, j] = m[s, r0 + i, r0 + j]
+        if _lu(b, k, piv, 0.0):
             return False
         for r in range(rhs.shape[1]):
             for c in range(n):
                 for i in range(n):
-                    x[i] = rhs[s, r, i, c]
-                _lu_solve(b, n, piv, x)
-                for i in range(n):
-                    out[s, r, i, c] = x[i]
+                    out[s, r, i, c] = rhs[s, r, i, c]
+                for i in range(k):
+                    acc = rhs[s, r, r0 + i, c]
+                    for j in range(r0):
+                        acc -= m[s, r0 + i, j] * rhs[s, r, j, c]
+                    for j in range(r1, n):
+                        acc -= m[s, r0 + i, j] * rhs[s, r, j, c]
+                    x[i] = acc
+                _lu_solve(b, k, piv, x)
+                for i in range(k):
+                    out[s, r, r0 + i, c] = x[i]
     return True
 
 
