@@ -30,26 +30,28 @@ __all__ = [
 Array = NDArray[np.float64]
 
 
+# S(a) and [I, -S(r)], row by row: the flat positions of their nonzero entries, the component
+# of the vector at each and its sign (filled in one gather instead of an assignment per entry)
+_SKEW_AT, _SKEW_FROM = np.array([1, 2, 3, 5, 6, 7]), np.array([2, 1, 2, 0, 1, 0])
+_SKEW_SIGN = np.array([-1.0, 1.0, 1.0, -1.0, -1.0, 1.0])
+_RIGID_ONE, _RIGID_AT = np.array([0, 7, 14]), np.array([4, 5, 9, 11, 15, 16])
+
+
 def skew(a: Array) -> Array:
     """Skew matrix ``S(a)`` with ``S(a) @ b = a x b``; works on stacks ``(..., 3)``."""
     a = np.asarray(a, dtype=float)
-    s = np.zeros(a.shape[:-1] + (3, 3))
-    s[..., 0, 1] = -a[..., 2]
-    s[..., 0, 2] = a[..., 1]
-    s[..., 1, 0] = a[..., 2]
-    s[..., 1, 2] = -a[..., 0]
-    s[..., 2, 0] = -a[..., 1]
-    s[..., 2, 1] = a[..., 0]
-    return s
+    s = np.zeros(a.shape[:-1] + (9,))
+    s[..., _SKEW_AT] = a[..., _SKEW_FROM] * _SKEW_SIGN
+    return s.reshape(a.shape[:-1] + (3, 3))
 
 
 def rigid_map(r: Array) -> Array:
     """``T(r) = [I, -S(r)]`` (3 x 6): displacement of the body point at arm ``r``."""
     r = np.asarray(r, dtype=float)
-    t = np.zeros(r.shape[:-1] + (3, 6))
-    t[..., :, :3] = np.eye(3)
-    t[..., :, 3:] = -skew(r)
-    return t
+    t = np.zeros(r.shape[:-1] + (18,))
+    t[..., _RIGID_ONE] = 1.0
+    t[..., _RIGID_AT] = r[..., _SKEW_FROM] * -_SKEW_SIGN
+    return t.reshape(r.shape[:-1] + (3, 6))
 
 
 def rigid_map6(r: Array) -> Array:

@@ -68,18 +68,21 @@ class _Terms:
 
     @classmethod
     def of(cls, model: Model) -> "_Terms":
-        entries = tuple((i, np.array(m.stiffness[:3, :3]), m.viscoelastic.weights, m.viscoelastic.relaxation_times)
-                        for i, m in enumerate(model.mounts) if m.viscoelastic is not None)
+        found = [(i, m.viscoelastic) for i, m in enumerate(model.mounts) if m.viscoelastic is not None]
+        k = np.array([model.mounts[i].stiffness[:3, :3] for i, _ in found]).reshape(-1, 3, 3)
+        entries = tuple((i, k[j], law.weights, law.relaxation_times) for j, (i, law) in enumerate(found))
         by_tau: dict[float, dict[int, float]] = {}  # tau -> {position of the mount: its g at tau}
-        for j, (_, _, g, tau) in enumerate(entries):
-            for gj, tj in zip(g.tolist(), tau.tolist()):
+        sums = []
+        for j, (_, law) in enumerate(found):
+            g = law.weights.tolist()
+            sums.append(sum(g))
+            for gj, tj in zip(g, law.relaxation_times.tolist()):
                 members = by_tau.setdefault(tj, {})
                 members[j] = members.get(j, 0.0) + gj
         groups = tuple((tj, tuple(members), np.array(list(members.values()))) for tj, members in by_tau.items())
-        return cls(entries, [e[0] for e in entries], np.array([e[1] for e in entries]).reshape(-1, 3, 3),
-                   np.array([sum(e[2].tolist()) for e in entries]), groups,
-                   np.array([[members.get(j, 0.0) for j in range(len(entries))] for members in by_tau.values()])
-                   .reshape(len(groups), len(entries)))
+        group_weights = np.array([[members.get(j, 0.0) for j in range(len(found))] for members in by_tau.values()])
+        return cls(entries, [i for i, _ in found], k, np.array(sums), groups,
+                   group_weights.reshape(len(groups), len(found)))
 
     def __iter__(self):
         return iter(self.entries)
@@ -99,7 +102,7 @@ def _terms(model: Model) -> _Terms:
 def _mount_maps(rho: Array, terms: _Terms) -> tuple[Array, Array, Array]:
     """For the viscoelastic mounts (in the order of ``terms``) at arms ``rho (..., nm, 3)``: their maps
     ``B_i (..., v, 3, 6)``, ``B_i^T k_i (..., v, 6, 3)`` and ``B_i^T k_i B_i (..., v, 6, 6)``."""
-    maps = rigid_map(rho[..., terms.mounts, :])
+    maps = rigid_map(rho if len(terms.mounts) == rho.shape[-2] else rho[..., terms.mounts, :])  # every mount: no gather
     btk = np.swapaxes(maps, -1, -2) @ terms.k
     return maps, btk, btk @ maps
 
@@ -109,10 +112,11 @@ def _reduced_ranks(maps: Array, terms: _Terms) -> dict[float, int]:
     thrust: the equilibrium only rotates the arms), from the maps ``(v, 3, 6)`` of :func:`_mount_maps`."""
     ranks: dict[float, int] = {}
     by_mounts: dict[tuple, int] = {}  # relaxation times of the same mounts share the rank
+    every = tuple(range(len(terms)))
     for tj, js, _ in terms.groups:
         if js not in by_mounts:
-            sv = np.linalg.svd(maps[list(js)].reshape(-1, 6), compute_uv=False)
-            by_mounts[js] = int((sv > 1e-12 * sv[0]).sum())
+            sv = np.linalg.svd((maps if js == every else maps[list(js)]).reshape(-1, 6), compute_uv=False)
+            by_mounts[js] = int(np.count_nonzero(sv > 1e-12 * sv[0]))
         ranks[tj] = by_mounts[js]
     return ranks
 
