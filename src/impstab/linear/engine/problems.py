@@ -16,6 +16,7 @@ family), and what the onset values need (the dofs of the mode, the participation
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -212,7 +213,7 @@ class _FirstOrderProvider:
 
 
 def _range(family, p_min: float, p_max: float, n_scan: int):
-    if not (np.isfinite(p_max) and np.isfinite(p_min) and p_max > p_min):
+    if not (math.isfinite(p_max) and math.isfinite(p_min) and p_max > p_min):
         raise ValueError(f"p_max = {p_max!r}: must be finite and above p_min = {p_min!r}")
     if int(n_scan) < 1:
         raise ValueError(f"n_scan = {n_scan!r}: must be at least 1")

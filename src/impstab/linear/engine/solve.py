@@ -291,29 +291,31 @@ def _warning(load: float) -> str:
 
 def _outcome(problem: Problem, onsets, mode, part, counts, all_crossings: bool, notes: tuple = ()) -> Outcome:
     method = "coalescence" if problem.undamped else "hopf"
-    evaluations, bisections = int(counts[EVALUATIONS]), int(counts[BISECTIONS])
+    counts = counts.tolist()  # Python numbers: reading numpy scalars one by one costs more than the rest
+    evaluations, bisections = counts[EVALUATIONS], counts[BISECTIONS]
     if counts[STATUS] != 0:
         err = getattr(problem.provider, "error", None) or RuntimeError("the stability engine stopped")
         return Outcome(None, "none", None, None, None, (), evaluations, (), err, method=method)
+    rows = onsets[: max(counts[BRACKETS], counts[FIRST] + 1, 1)].tolist()
     if counts[START_UNSTABLE]:
-        row = onsets[0]
-        return Outcome(float(row[LOAD]), _KINDS[int(row[KIND])], float(row[OMEGA]), mode.copy(), part.copy(), (),
+        row = rows[0]
+        return Outcome(row[LOAD], _KINDS[int(row[KIND])], row[OMEGA], mode.copy(), part.copy(), (),
                        evaluations, unstable_at_start=True, method=method)
     found: list[Crossing] = []
     warnings: list[str] = list(notes)
     first = int(counts[FIRST])
     best = None
     if first >= 0:
-        row = onsets[first]
-        best = (float(row[LOAD]), _KINDS[int(row[KIND])], float(row[OMEGA]), mode.copy(), part.copy())
-    for row in onsets[: counts[BRACKETS]]:
+        row = rows[first]
+        best = (row[LOAD], _KINDS[int(row[KIND])], row[OMEGA], mode.copy(), part.copy())
+    for row in rows[: counts[BRACKETS]]:
         direction = "loss" if row[DIRECTION] > 0 else "gain"
         if row[KIND] == LIMIT:
             p, kind, omega, m, pa = limit_point(problem, float(row[LO]), float(row[HI]))
             if direction == "loss" and (best is None or p < best[0]):
                 best = (p, kind, omega, m, pa)
         else:
-            p, kind, omega = float(row[LOAD]), _KINDS[int(row[KIND])], float(row[OMEGA])
+            p, kind, omega = row[LOAD], _KINDS[int(row[KIND])], row[OMEGA]
         if row[WARNED]:
             warnings.append(_warning(p))
         if all_crossings or best is None:
