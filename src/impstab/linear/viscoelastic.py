@@ -166,7 +166,7 @@ def augmented_matrices(m: Array, c: Array, k: Array, rho: Array, terms, reduced:
     n = 2 * nq + sum(force.shape[-1] for _, force, _ in blocks)
     e = np.zeros((s, n, n))
     a = np.zeros((s, n, n))
-    e.reshape(s, n * n)[:, :: n + 1] = 1.0
+    _diagonal(e, 0, 0, n)[...] = 1.0
     e[:, nq:2 * nq, nq:2 * nq] = m
     _diagonal(a, 0, nq, nq)[...] = 1.0
     a[:, nq:2 * nq, nq:2 * nq] = -c
