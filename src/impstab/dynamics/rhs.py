@@ -128,7 +128,8 @@ def _cross3(a0, a1, a2, b0, b1, b2):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _euler_into(phi, theta, psi, rot):
-    """Rotation body -> hull for z-y-x Euler angles (``J1``); same formula as the linear module."""
+    """Rotation body -> hull for z-y-x Euler angles (``J1``); same formula as the linear module.
+    Returns ``(cos phi, sin phi, cos theta, sin theta)`` for the kinematics ``J2``."""
     cf, sf = cos(phi), sin(phi)
     ct, st = cos(theta), sin(theta)
     cp, sp = cos(psi), sin(psi)
@@ -141,6 +142,7 @@ def _euler_into(phi, theta, psi, rot):
     rot[2, 0] = -st
     rot[2, 1] = ct * sf
     rot[2, 2] = ct * cf
+    return cf, sf, ct, st
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -160,11 +162,12 @@ def _rotate_t(rot, x0, x1, x2):
 @njit(cache=True, inline="always", error_model="numpy")
 def _pose_into(par, yeq, z, rot, jinv, ws):
     """R into ``rot``; when a mount has rotational terms, ``log R`` into ``ws[0:3]`` and
-    ``J_l^{-1}(log R)`` into ``jinv``."""
-    _euler_into(yeq[3] + z[3], yeq[4] + z[4], yeq[5] + z[5], rot)
+    ``J_l^{-1}(log R)`` into ``jinv``. Returns ``(cos phi, sin phi, cos theta, sin theta)``."""
+    trig = _euler_into(yeq[3] + z[3], yeq[4] + z[4], yeq[5] + z[5], rot)
     if par[P_ROTATION] != 0.0:
         _log_so3_into(rot, ws)
         _jinv_into(ws, jinv)
+    return trig
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -355,15 +358,14 @@ def model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, bpos
     still computed unless ``cos(theta)`` vanishes).
     """
     theta = yeq[4] + z[4]
-    ct = cos(theta)
     status = OK
     if abs(theta.real) >= par[P_PITCH]:
         status = PITCH
-        if abs(ct.real) < 1e-12:
+        if abs(cos(theta).real) < 1e-12:
             for i in range(out.shape[0]):
                 out[i] = math.nan
             return status
-    _pose_into(par, yeq, z, rot, jinv, ws)
+    cf, sf, ct, st = _pose_into(par, yeq, z, rot, jinv, ws)
     x0, x1, x2 = yeq[0] + z[0], yeq[1] + z[1], yeq[2] + z[2]
     u, v, w = yeq[6] + z[6], yeq[7] + z[7], yeq[8] + z[8]
     p, q, r = yeq[9] + z[9], yeq[10] + z[10], yeq[11] + z[11]
@@ -371,8 +373,7 @@ def model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, bpos
     wh0, wh1, wh2 = _rotate(rot, p, q, r)
     # kinematics: X' = R nu1, Xi' = J2(Xi) nu2
     out[0], out[1], out[2] = vh0, vh1, vh2
-    sf, cf = sin(yeq[3] + z[3]), cos(yeq[3] + z[3])
-    tt = sin(theta) / ct
+    tt = st / ct
     out[3] = p + sf * tt * q + cf * tt * r
     out[4] = cf * q - sf * r
     out[5] = (sf * q + cf * r) / ct
