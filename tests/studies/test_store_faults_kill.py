@@ -232,6 +232,13 @@ def interrupted(tmp_path_factory):
     return study, folder / "ref.zarr"
 
 
+def _as_a_terminal_starts_it() -> None:
+    """Ctrl-C's default disposition, as a shell gives a foreground program: a test runner started
+    in the background of a non-interactive shell ignores SIGINT, and an ignored signal stays
+    ignored across ``exec``, so the command would run to its end and exit 0."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("where,after", [("in-process", 3), ("dask", 3), ("dask", 0)],
                          ids=["in-process", "dask-mid-run", "dask-while-the-cluster-starts"])
 def test_ctrl_c_in_a_terminal_ends_in_one_line_and_resumes(tmp_path, interrupted, where, after):
@@ -246,7 +253,7 @@ def test_ctrl_c_in_a_terminal_ends_in_one_line_and_resumes(tmp_path, interrupted
     cmd = [sys.executable, "-c", _CLI_DASK_ONLY if after else _CLI, *args]
     env = dict(os.environ, PYTHONPATH=str(SRC), MPLBACKEND="Agg")
     with subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env,
-                          start_new_session=True) as proc:
+                          start_new_session=True, preexec_fn=_as_a_terminal_starts_it) as proc:
         deadline = time.time() + 120
         while time.time() < deadline and proc.poll() is None and not (store.exists() and _records_done(store) >= after):
             time.sleep(0.005)  # after=0: the store is made, the cluster is starting
