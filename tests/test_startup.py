@@ -216,6 +216,20 @@ def test_precompile_cases_are_valid_command_lines(tmp_path, monkeypatch, from_ex
         assert all(Path(argv[1]).is_relative_to(tmp_path) for _, argv in todo)
 
 
+@pytest.mark.parametrize("from_examples", [True, False])
+def test_precompile_warm_ups_run(tmp_path, monkeypatch, from_examples):
+    """The first phase's calls (the shared kernels, compiled side by side) run on the bundled
+    examples and on the models written for an installed package."""
+    from impstab import precompile
+
+    if not from_examples:
+        monkeypatch.setattr(precompile, "EXAMPLES", tmp_path / "missing")
+    first = precompile.warm_ups(precompile._models(tmp_path))
+    assert len(first) == 2
+    for label, func, args in first:
+        assert precompile._warm(label, func, args, quiet=True) == [], label
+
+
 def test_precompile_stops_at_a_complete_cache_and_keeps_the_users_own(tmp_path, monkeypatch, capsys):
     from impstab import precompile
 
