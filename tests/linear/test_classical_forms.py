@@ -16,15 +16,28 @@ import pytest
 from impstab.linear.linearize import affine_forms, pack_model
 from impstab.linear.tangent import classical_forms, linearize_batch
 from impstab.model import load_model
+from impstab.model.mount_law import N_LAW
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "examples").glob("*.toml"))
 EXAMPLES = [p for p in EXAMPLES if not p.name.startswith(("study_", "optimize_"))]  # model files only
 
 
-# The kernels are called with arguments of the types the library passes (read-only thrust
-# direction and point, as in a model; the start pose given, here the default unloaded one), so
-# that they reuse the machine code compiled for the commands instead of compiling variants.
+# The kernels are called with arguments of the types the library passes, so that they run the
+# machine code compiled for the commands, not variants of their own (each a compilation of tens of
+# seconds in the test run): classical_forms takes writable stacks of designs; linearize_batch a
+# model's read-only thrust direction and point, the start pose (here the default unloaded one)
+# and the mount laws as a model packs them (zeros for linear mounts).
 START = (0.0, np.zeros(3), np.eye(3))
+
+
+def _linear_laws(positions):
+    return np.zeros((len(positions), N_LAW))
+
+
+def _as_in_a_model(a):
+    view = a.view()
+    view.flags.writeable = False
+    return view
 
 
 def _reference(mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tangency, preload):
@@ -33,8 +46,9 @@ def _reference(mass6, damp6, positions, stiffness, damping, e_dir, r_thrust, tan
     for i in range(len(mass6)):
         big = 1e8 * max(np.abs(stiffness[i]).max(), 1e-300) * max(np.linalg.norm(positions[i], axis=-1).max(), 1e-3)
         m, d, g, k, _, _, _ = linearize_batch(
-            np.array([0.0, big]), np.ones(2), mass6[i], damp6[i], positions[i], stiffness[i], damping[i], e_dir[i],
-            r_thrust[i], tangency[i], preload, 1.0, False, 1.0, *START,
+            np.array([0.0, big]), np.ones(2), mass6[i], damp6[i], positions[i], stiffness[i], damping[i],
+            _as_in_a_model(e_dir[i]), _as_in_a_model(r_thrust[i]), tangency[i], preload, 1.0, False, 1.0, *START,
+            _linear_laws(positions[i]),
         )
         out.append((m[0], d[0], g[0], k[0], (k[1] - k[0]) / big))
     return [np.array(a) for a in zip(*out)]
@@ -62,7 +76,6 @@ def _random_designs(rng, n, nm):
     e_dir = rng.normal(size=(n, 3))
     e_dir /= np.linalg.norm(e_dir, axis=-1, keepdims=True)
     r_thrust = rng.uniform(-0.3, 0.3, (n, 3))
-    e_dir.flags.writeable = r_thrust.flags.writeable = False  # as a model's (see START)
     return (_spd(rng, n, 10.0), _spd(rng, n, 0.1), positions, stiffness, damping, e_dir,
             r_thrust, rng.uniform(0.0, 1.0, n))
 
@@ -79,7 +92,7 @@ def test_random_layouts_equal_the_general_kernel(preload, nm):
 @pytest.mark.parametrize("damped", [True, False])
 def test_examples_equal_the_general_kernel(path, damped):
     pk = pack_model(load_model(path), damped=damped)
-    stack = lambda a: np.asarray(a, dtype=float)[None]  # noqa: E731
+    stack = lambda a: np.array(a, dtype=float)[None]  # noqa: E731  (writable, as the library stacks designs)
     args = (stack(pk.mass6), stack(pk.damp6), stack(pk.positions), stack(pk.stiffness), stack(pk.damping),
             stack(pk.e_dir), stack(pk.r_thrust), stack(pk.tangency))
     m, d, k0, k1, g, _ = affine_forms(*args, pk.preload, stack(pk.length_scale), False)
@@ -95,8 +108,8 @@ def test_affine_form_is_the_stiffness_at_each_thrust(preload):
     for i in range(10):
         thrusts = np.array([0.0, 0.01, -0.1, 1.0]) * np.abs(k0[i]).max()  # N, against arms of ~0.3 m
         mi, di, gi, ki, _, _, _ = linearize_batch(
-            thrusts, np.ones(4), mass6[i], damp6[i], positions[i], stiffness[i], damping[i], e_dir[i], r_thrust[i],
-            tangency[i], preload, 1.0, False, 1.0, *START,
+            thrusts, np.ones(4), mass6[i], damp6[i], positions[i], stiffness[i], damping[i], _as_in_a_model(e_dir[i]),
+            _as_in_a_model(r_thrust[i]), tangency[i], preload, 1.0, False, 1.0, *START, _linear_laws(positions[i]),
         )
         got = k0[i] + thrusts[:, None, None] * k1[i]
         assert np.abs(ki[-1] - ki[0]).max() > 0.05 * np.abs(ki[0]).max()  # the thrust matters
