@@ -13,6 +13,23 @@ import pytest  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 
+#: the modules that take longest (10 to 100 s of one worker each, measured on two cores), first:
+#: ``make test`` keeps each module on one worker (``--dist loadscope``), and a long module handed
+#: out last leaves the other worker idle until it ends
+LONGEST_FIRST = (
+    "studies/test_store_faults_kill.py", "test_docs_commands.py", "test_jit.py", "studies/test_store_faults.py",
+    "postcritical/test_onset_labels.py", "postcritical/test_propulsor.py", "report/test_report_content.py",
+    "dynamics/test_dyn_beam_mounts.py", "studies/test_dask.py", "studies/test_store_resume.py",
+    "report/test_report_browser.py", "postcritical/test_propulsor_beam_mounts.py",
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    """The longest modules first (a stable sort: the rest, and the tests in a module, keep their order)."""
+    rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
+    here = Path(__file__).resolve().parent
+    items.sort(key=lambda item: rank.get(item.path.resolve().relative_to(here).as_posix(), len(rank)))
+
 
 @pytest.fixture
 def examples() -> Path:
