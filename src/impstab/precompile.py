@@ -9,11 +9,11 @@ it for minutes.
 
 Two phases, each spread over ``--jobs`` processes (default the cores available, at most 4).
 Every command computes a critical thrust first, so every case needs the kernels of the stability
-engine and of the tangent stiffness at the static equilibrium: two independent sets, about 70 %
-and 30 % of the shared compile work. The first phase compiles them side by side through two
-public entry points (:func:`warm_ups`: ``critical_load`` on a generic family, then ``linearize``
-and ``simulate`` of a model), so that no case starts before they are in the cache (two processes
-each compiling the engine would do the same minute of work twice). The second phase runs each
+engine and of the tangent stiffness at the static equilibrium: two independent sets, about two
+thirds and one third of the shared compile work. The first phase compiles them side by side
+through public entry points (:func:`warm_ups`: ``critical_load`` on a generic family; then
+``linearize`` and ``simulate`` of a model), so that no case starts before they are in the cache
+(two processes each compiling the engine would do the same minute of work twice). The second phase runs each
 command's cases in a process of their own, the heaviest first; they load the shared kernels and
 compile only their own.
 
