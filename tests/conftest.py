@@ -13,14 +13,15 @@ import pytest  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 
-#: the modules that take longest (10 to 100 s of one worker each, measured on two cores), first:
+#: the modules that take longest (7 to 45 s of one worker each, measured on two cores), first:
 #: ``make test`` keeps each module on one worker (``--dist loadscope``), and a long module handed
 #: out last leaves the other worker idle until it ends
 LONGEST_FIRST = (
-    "studies/test_store_faults_kill.py", "test_docs_commands.py", "test_jit.py", "studies/test_store_faults.py",
-    "postcritical/test_onset_labels.py", "postcritical/test_propulsor.py", "report/test_report_content.py",
-    "dynamics/test_dyn_beam_mounts.py", "studies/test_dask.py", "studies/test_store_resume.py",
-    "report/test_report_browser.py", "postcritical/test_propulsor_beam_mounts.py",
+    "test_docs_commands.py", "studies/test_store_faults_kill.py", "postcritical/test_onset_labels.py",
+    "studies/test_store_faults.py", "postcritical/test_propulsor.py", "dynamics/test_dyn_beam_mounts.py",
+    "report/test_report_content.py", "test_jit.py", "report/test_report_browser.py",
+    "postcritical/test_propulsor_beam_mounts.py", "studies/test_statistics.py", "studies/test_store_faults_disk.py",
+    "studies/test_dask.py", "studies/test_store_resume.py",
 )
 
 
