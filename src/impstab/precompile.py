@@ -123,9 +123,10 @@ def _with_lumped_hull(folder: Path, model: Path) -> Path:
     return path
 
 
-def cases(folder: Path) -> list[tuple[str, list[str]]]:
-    """``(label, argv)`` of each command run: every kernel path of the command line."""
-    models = _models(folder)
+def cases(folder: Path, models: dict[str, Path] | None = None) -> list[tuple[str, list[str]]]:
+    """``(label, argv)`` of each command run: every kernel path of the command line (``models``:
+    those of :func:`_models`, found or written into ``folder`` when not given)."""
+    models = _models(folder) if models is None else models
     sym = str(models["symmetric"])
     out: list[tuple[str, list[str]]] = []
     # every case but one on each model: the massive beam mounts' --all-crossings compiles nothing
@@ -303,9 +304,10 @@ def main(argv: list[str] | None = None) -> int:
     print(f"impstab: compiling kernels into {_numba_cache.cache_dir()} ({jobs} processes)", flush=True)
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="impstab-precompile-") as tmp:
-        numbered = [(k, label, a) for k, (label, a) in enumerate(cases(Path(tmp)), 1)]
+        models = _models(Path(tmp))
+        numbered = [(k, label, a) for k, (label, a) in enumerate(cases(Path(tmp), models), 1)]
         total = len(numbered)
-        first = warm_ups(_models(Path(tmp)))
+        first = warm_ups(models)
         groups = _groups(numbered, jobs)
         failed: list[tuple[str, str]] = []
         if jobs > 1:
