@@ -29,7 +29,12 @@ def pytest_collection_modifyitems(config, items):
     """The longest modules first (a stable sort: the rest, and the tests in a module, keep their order)."""
     rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
     here = Path(__file__).resolve().parent
-    items.sort(key=lambda item: rank.get(item.path.resolve().relative_to(here).as_posix(), len(rank)))
+
+    def place(item) -> int:
+        path = item.path.resolve()  # items from outside tests/ (doctests of src/, say) keep their order
+        return rank.get(path.relative_to(here).as_posix(), len(rank)) if path.is_relative_to(here) else len(rank)
+
+    items.sort(key=place)
 
 
 @pytest.fixture
