@@ -13,9 +13,9 @@ engine and of the tangent stiffness at the static equilibrium: two independent s
 thirds and one third of the shared compile work. The first phase compiles them side by side
 through public entry points (:func:`warm_ups`: ``critical_load`` on a generic family; then
 ``linearize`` and ``simulate`` of a model), so that no case starts before they are in the cache
-(two processes each compiling the engine would do the same minute of work twice). The second phase runs each
-command's cases in a process of their own, the heaviest first; they load the shared kernels and
-compile only their own.
+(two processes each compiling the engine would do the same minute of work twice). The second
+phase runs each command's cases in a process of their own, the heaviest first; they load the
+shared kernels and compile only their own.
 
 The cases use the bundled ``examples/`` when run from a source tree, else two small models
 and a small study written here. A command that uses kernels gets a line in :func:`cases`;
@@ -199,17 +199,28 @@ def warm_ups(models: dict[str, Path]) -> list[tuple[str, object, tuple]]:
 
 def _warm(label: str, func, args: tuple, quiet: bool) -> list[tuple[str, str]]:
     """Run one warm-up in this process; its failure ``(label, message)``, if any."""
+    with _progress("warm-up", label, quiet):
+        try:
+            func(*args)
+        except Exception as exc:  # reported with the cases' failures; the cases still run
+            return [(label, f"{type(exc).__name__}: {exc}")]
+    return []
+
+
+@contextlib.contextmanager
+def _progress(tag: str, label: str, quiet: bool):
+    """One progress line for the block: its seconds and the kernel signatures it compiled and
+    loaded; the block may set ``status`` in the yielded dict (appended to the line)."""
     t0 = time.perf_counter()
     before = _counts() if "numba" in sys.modules else (0, 0)
+    note = {"status": ""}
     try:
-        func(*args)
-    except Exception as exc:  # reported with the cases' failures; the cases still run
-        return [(label, f"{type(exc).__name__}: {exc}")]
-    after = _counts() if "numba" in sys.modules else (0, 0)
-    if not quiet:
-        print(f"  [warm-up] {label:36s} {time.perf_counter() - t0:6.1f} s  compiled "
-              f"{after[0] - before[0]:3d}, from the cache {after[1] - before[1]:3d}", flush=True)
-    return []
+        yield note
+    finally:
+        after = _counts() if "numba" in sys.modules else (0, 0)
+        if not quiet:
+            print(f"  [{tag}] {label:36s} {time.perf_counter() - t0:6.1f} s  compiled {after[0] - before[0]:3d}, "
+                  f"from the cache {after[1] - before[1]:3d}{note['status']}", flush=True)
 
 
 def kernels() -> dict[str, object]:
@@ -253,16 +264,11 @@ def _run(numbered: list[tuple[int, str, list[str]]], total: int, quiet: bool) ->
 
     failed = []
     for k, label, argv in numbered:
-        t0 = time.perf_counter()
-        before = _counts() if "numba" in sys.modules else (0, 0)
         out, err = io.StringIO(), io.StringIO()
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            code = cli_main(argv)
-        after = _counts() if "numba" in sys.modules else (0, 0)
-        status = "" if code == 0 else f"  FAILED (exit {code})"
-        if not quiet:
-            print(f"  [{k:2d}/{total}] {label:36s} {time.perf_counter() - t0:6.1f} s  compiled "
-                  f"{after[0] - before[0]:3d}, from the cache {after[1] - before[1]:3d}{status}", flush=True)
+        with _progress(f"{k:2d}/{total}", label, quiet) as note:
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+                code = cli_main(argv)
+            note["status"] = "" if code == 0 else f"  FAILED (exit {code})"
         if code != 0:
             failed.append((label, err.getvalue().strip()))
     return failed
