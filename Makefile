@@ -17,12 +17,15 @@ EXAMPLE := examples/imp_symmetric.toml
 # module-scoped fixtures are computed once
 JOBS   ?= auto
 
-# the bytecode of every module installed in the environment (files that do not compile, such as
-# another Python version's, are skipped without a word: Python reads their source if ever imported)
+# the bytecode of every module installed in the environment, but for the packages' own test suites
+# and pip, which no command imports (a third of the files: 24 s -> 14 s on two cores). Files that do
+# not compile, such as another Python version's, are skipped without a word: Python reads the
+# source of whatever has no bytecode if it is ever imported
 define BYTECODE
-import compileall, sysconfig
+import compileall, re, sysconfig
+skip = re.compile(r"/tests?/|/site-packages/pip/")
 for folder in sorted({sysconfig.get_paths()[k] for k in ("purelib", "platlib")}):
-    compileall.compile_dir(folder, quiet=2, workers=0)
+    compileall.compile_dir(folder, quiet=2, workers=0, rx=skip)
 endef
 export BYTECODE
 
