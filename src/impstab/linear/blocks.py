@@ -290,7 +290,7 @@ def _vector2(lam, a, b, c, d, first):
     return complex(0.0, 0.0), complex(1.0, 0.0)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _fill_block(a0, a1, s, p, order, lo, m, w):
     """``w[:m, :m]`` = the block of dofs ``order[s, lo:lo + m]`` of ``a0[s] + p a1[s]``."""
     for x in range(m):
@@ -299,7 +299,7 @@ def _fill_block(a0, a1, s, p, order, lo, m, w):
             w[x, y] = a0[s, i, j] + p * a1[s, i, j]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def block_eigvals_at(a0, a1, s, p, order, starts, nblocks, mirror, fixed, w, v, wr, wi, out):
     """Eigenvalues of design ``s`` at load ``p``, block by block, into ``out (n,)``; False: failed.
 
@@ -374,7 +374,7 @@ def eig_workspace(n):
             np.empty(n, dtype=np.int64), np.empty(n, dtype=np.complex128), np.empty((n, n)), np.empty(n))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def block_eig_at(a0, a1, s, p, order, starts, nblocks, mirror, vals, vecs, inv, ws):
     """Eigen-decomposition of design ``s`` at load ``p``, block by block; False: failed.
 
@@ -430,7 +430,9 @@ def block_eig_at(a0, a1, s, p, order, starts, nblocks, mirror, vals, vecs, inv, 
             inv[lo + 1, i] = -v10 / det
             inv[lo + 1, j] = v00 / det
             continue
-        w[:m, :m] = w0[:m, :m]
+        for xx in range(m):  # loops, not a slice copy: numba's array copy needs its runtime
+            for yy in range(m):
+                w[xx, yy] = w0[xx, yy]
         if not _eig_block(w, w0, m, v, wr, wi, bv, bvec, binv, lu, piv, x, lu_real, x_real):
             good = False
             continue

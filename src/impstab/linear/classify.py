@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 __all__ = ["unstable_masks", "classify_eigenvalues"]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _masks(vals, undamped, tol_unstable, tol_cluster, floor_rel, cplx, neg):
     count, n = vals.shape
     for s in range(count):

@@ -36,7 +36,7 @@ _EPS = float(np.finfo(float).eps)
 _MAX_ITERATIONS = 60  # per eigenvalue, as EISPACK hqr (30 per eigenvalue in dlahqr, x n in total)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _balance(a, n, f):
     """Scale rows and columns by powers of two until their off-diagonal norms are comparable.
 
@@ -76,7 +76,7 @@ def _balance(a, n, f):
                     a[j, i] *= step
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _hessenberg(a, n, v):
     """Householder reduction of ``a`` (in place) to upper Hessenberg form."""
     for k in range(n - 2):
@@ -115,7 +115,7 @@ def _hessenberg(a, n, v):
             a[i, k] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _hessenberg_norm(a, n):
     s = 0.0
     for i in range(n):
@@ -124,7 +124,7 @@ def _hessenberg_norm(a, n):
     return s
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _francis(a, n, wr, wi):  # noqa: C901 - one algorithm, kept in one piece
     """Eigenvalues of the upper Hessenberg ``a`` (destroyed) into ``wr + i wi``; False: no convergence."""
     hi = n - 1
@@ -262,7 +262,7 @@ def _solve_one_lapack(a, n, v, wr, wi, out_row):
     return True
 
 
-@njit(cache=True, error_model="numpy", interpreted=_solve_one_lapack)
+@njit(cache=True, error_model="numpy", _nrt=False, interpreted=_solve_one_lapack)
 def _solve_one(a, n, v, wr, wi, out_row):
     """Eigenvalues of the matrix in ``a`` (destroyed) into ``out_row``.
 

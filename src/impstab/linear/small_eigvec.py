@@ -29,7 +29,7 @@ from .small_eig import _solve_one
 _EPS = float(np.finfo(float).eps)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _lu(b, m, piv, tiny):
     """LU factorisation with partial pivoting of the complex ``b[:m, :m]`` in place.
 
@@ -66,7 +66,7 @@ def _lu(b, m, piv, tiny):
     return hit
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _lu_solve(b, m, piv, x):
     """Solve ``B y = x`` in place with the factors of :func:`_lu`."""
     for k in range(m):
@@ -84,7 +84,7 @@ def _lu_solve(b, m, piv, x):
         x[i] /= b[i, i]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _eigvector(w0, m, lam, norm, b, piv, x):
     """Unit eigenvector of ``w0[:m, :m]`` for the computed eigenvalue ``lam``, by inverse iteration.
 
@@ -151,7 +151,7 @@ def lapack_eig(op, vals, vecs, inv):
     return 1 if np.isfinite(inv).all() else 0
 
 
-@njit(cache=True, error_model="numpy", interpreted=_eig_block_lapack)
+@njit(cache=True, error_model="numpy", _nrt=False, interpreted=_eig_block_lapack)
 def _eig_block(w, w0, m, v, wr, wi, vals, vecs, inv, b, piv, x, b_real, x_real):
     """Eigenvalues (compiled QR), unit eigenvectors and their inverse of the block ``w0[:m, :m]``.
 

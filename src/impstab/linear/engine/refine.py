@@ -58,7 +58,7 @@ def _relative_real(v):
     return v.real / mag if mag > 0 else 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def unstable_cluster(vals, undamped, members, cplx, neg):
     """The cluster that is unstable into the mask ``members``; returns ``(found, unique, divergence)``.
 
@@ -108,7 +108,7 @@ def unstable_cluster(vals, undamped, members, cplx, neg):
     return True, unique, divergence
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def projector(vecs, inv, members, vc, wc):
     """The cluster's oblique projector ``V_C W_C^H`` as ``vc (n, k)``, ``wc (k, n)``; returns ``k``."""
     n = vecs.shape[0]
@@ -160,7 +160,7 @@ def select(vecs, vc, wc, k, sel, share):
     return share[order[k - 1]] > 0.25 and (n == k or share[order[k]] < 0.25)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _pair_growth(v, k):
     """Largest real part of a cluster (upper half plane), from its symmetric functions.
 
@@ -322,7 +322,7 @@ def hermite_root(a, b, fa, fb, da, db):
     return x if min(a, b) < x < max(a, b) else secant
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def newton_step(st, p, f, df):
     """Bracketed Newton (bisection guard) after ``f, df`` at ``p``; returns ``(next, done)``.
 
@@ -352,7 +352,7 @@ def newton_step(st, p, f, df):
     return new, quadratic and (step / (prev * prev)) * step * step <= EPS * abs(new)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def brent_step(st, f):
     """scipy's ``brentq`` (xtol 1e-300, rtol 4 eps) as steps; returns ``(x, done)``.
 

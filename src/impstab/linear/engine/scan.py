@@ -54,7 +54,7 @@ def _classify(vals, lost, undamped, flags, ind, cplx, neg):
 
 # -- scipy's bounded Brent minimisation, as steps (reverse communication) ------------------------
 # state: a, b, fulc, nfc, xf, rat, e, fx, ffulc, fnfc, num, xatol, x, phase, xm, tol1, tol2
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def fmin_start(st, x1, x2, xatol):
     """Start ``_minimize_scalar_bounded`` on ``(x1, x2)``; returns the first point to evaluate."""
     st[0], st[1] = x1, x2
@@ -67,7 +67,7 @@ def fmin_start(st, x1, x2, xatol):
     return st[12]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def fmin_next(st, f):
     """Give ``f`` at the last point; returns ``(next point, more)`` (``more`` False: done)."""
     a, b, fulc, nfc, xf, rat, e, fx, ffulc, fnfc, num, xatol = st[0], st[1], st[2], st[3], st[4], st[5], st[6], \

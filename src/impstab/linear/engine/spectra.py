@@ -22,6 +22,15 @@ function's callees into it and optimises them again, so the engine keeps a singl
 above these routines). Decompositions are kept in a small cache (least recently used) per
 problem. A provider that raises stops its own problem only: the exception is kept on the
 provider and the problem reports :data:`PROVIDER_ERROR`.
+
+Reference counts: :func:`spectrum` and the small-matrix routines under it allocate nothing and are
+compiled without numba's runtime (``_nrt=False``, as the simulation's right-hand side). With the
+runtime, numba increments and decrements the count of every array a function receives, each
+array of a tuple included, with an atomic instruction, once per call: 4,790 of them in one
+``critical_load`` of the asymmetric example, about a fifth of its compiled time, most of them on
+the 44 arrays of ``spectrum``'s three tuples. A callee without its own setting is compiled with
+its caller's, so the few that must keep the runtime say ``_nrt=True``: those that enter object
+mode, where arrays made in compiled code are handed to Python.
 """
 
 from __future__ import annotations
@@ -88,14 +97,14 @@ def _lapack_eigvals(op, out):
 
 
 # -- compiled ----------------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=True)
 def _provided_operators(key, loads, out):
     with objmode(status="int64"):
         status = _bridge_operators(key, loads, out)
     return status
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=True)
 def provided_weights(key, p, out):
     """Participation weights at ``p`` from the provider ``key``; 0, or 1 when it raised."""
     with objmode(status="int64"):
@@ -103,13 +112,13 @@ def provided_weights(key, p, out):
     return status
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=True)
 def _lapack_values(op, out):
     with objmode():
         _lapack_eigvals(op, out)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=True)
 def _lapack_vectors(op, vals, vecs, inv):
     with objmode(status="int64"):
         status = lapack_eig(op, vals, vecs, inv)
@@ -137,7 +146,7 @@ def cache_new(n):
             np.zeros(SLOTS, dtype=np.int64), np.zeros(1, dtype=np.int64))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _finite(a):
     for x in a.flat:
         if not np.isfinite(x):
@@ -145,7 +154,7 @@ def _finite(a):
     return True
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def operators_at(jobs, j, loads, out):
     """``out[i] = A_j(loads[i])``; returns 0, or 1 when the provider failed."""
     if jobs.ints[j, AFFINE]:
@@ -159,19 +168,21 @@ def operators_at(jobs, j, loads, out):
     return _provided_operators(jobs.ints[j, KEY], loads, out)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _values_of(op, ws, out):
     """Eigenvalues of the real matrix ``op`` into ``out``: compiled QR, else LAPACK."""
     n = op.shape[0]
     if n <= MAX_ORDER:
         w, v, wr, wi = ws[1], ws[2], ws[3], ws[4]
-        w[:, :] = op
+        for r in range(n):  # a loop, not ``w[:, :] = op``: numba's array copy needs its runtime
+            for c in range(n):
+                w[r, c] = op[r, c]
         if _solve_one(w, n, v, wr, wi, out):
             return
     _lapack_values(op, out)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     """Eigenvalues or a decomposition of problem ``j``; returns ``(status, slot)``.
 
