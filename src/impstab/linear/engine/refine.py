@@ -122,7 +122,7 @@ def projector(vecs, inv, members, vc, wc):
     return k
 
 
-def _select_numpy(vecs, vc, wc, k, sel, share):
+def _select_numpy(vecs, vc, wc, k, sel, share, t):
     """:func:`select` for interpreted runs: the same shares as two matrix products."""
     n = vecs.shape[0]
     proj = vc[:, :k] @ (wc[:k] @ vecs)
@@ -132,15 +132,30 @@ def _select_numpy(vecs, vc, wc, k, sel, share):
     return share[order[k - 1]] > 0.25 and (n == k or share[order[k]] < 0.25)
 
 
-@njit(cache=True, error_model="numpy", interpreted=_select_numpy)
-def select(vecs, vc, wc, k, sel, share):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _next_largest(share, n, sel, i):
+    """The column with the largest share that is not in ``sel[:i]``, the lowest on ties (the order of
+    a stable sort by decreasing share; NaN last)."""
+    best = -1
+    for c in range(n):
+        taken = False
+        for x in range(i):
+            taken = taken or sel[x] == c
+        if not taken and (best < 0 or share[c] > share[best] or (np.isnan(share[best]) and not np.isnan(share[c]))):
+            best = c
+    return best
+
+
+@njit(cache=True, error_model="numpy", interpreted=_select_numpy, _nrt=False)
+def select(vecs, vc, wc, k, sel, share, t):
     """The ``k`` eigenvectors lying most in the cluster subspace into ``sel[:k]``; whether clear.
 
     ``vecs`` are unit columns; the share of each is the squared norm of its oblique projection
     onto the cluster subspace; clear when the ``k``-th share exceeds 1/4 and the next is below.
+    ``share (n,)`` receives the shares, ``t (k,)`` complex is work space. The ``k`` columns are
+    picked one by one (the cluster is small), in the order of a stable sort by decreasing share.
     """
     n = vecs.shape[0]
-    t = np.empty(k, dtype=np.complex128)
     for c in range(n):
         for i in range(k):
             s = 0j
@@ -154,10 +169,13 @@ def select(vecs, vc, wc, k, sel, share):
                 y += vc[r, i] * t[i]
             total += y.real * y.real + y.imag * y.imag
         share[c] = total
-    order = np.argsort(-share[:n], kind="mergesort")
     for i in range(k):
-        sel[i] = order[i]
-    return share[order[k - 1]] > 0.25 and (n == k or share[order[k]] < 0.25)
+        sel[i] = _next_largest(share, n, sel, i)
+    if not share[sel[k - 1]] > 0.25:
+        return False
+    if n == k:
+        return True
+    return share[_next_largest(share, n, sel, k)] < 0.25
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -186,8 +204,9 @@ def _pair_growth(v, k):
     return c.real + abs(np.sqrt(d).real)
 
 
-@njit(cache=True, error_model="numpy")
-def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, derivative, sel, share, coalesce=False):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, derivative, sel, share, work,
+              coalesce=False):
     """``(f, df, clear)``: the exact indicator of the cluster in the decomposition, its derivative.
 
     ``df`` (affine problems, ``derivative``) from the eigenvalue derivatives ``W_C A1 V_C``;
@@ -196,26 +215,25 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
     discriminant of the cluster's upper half, ``Re(m sum lambda^2 - (sum lambda)^2)``, negative
     while two frequencies ``i w_1, i w_2`` are distinct, positive once they have split into
     ``+-a + i b``, and like the undamped ``Delta`` analytic through the defective double root.
+    ``work (3, n)`` complex is work space.
     """
-    if not select(vecs, vc, wc, k, sel, share):
+    if not select(vecs, vc, wc, k, sel, share, work[0]):
         return 0.0, 0.0, False
-    v = np.empty(k, dtype=np.complex128)
+    v, b = work[1], work[2]
     for i in range(k):
         v[i] = vals[sel[i]]
     jj = 0
-    half = np.ones(k, dtype=np.bool_)
+    # the members counted: all, or with ``coalesce`` the upper half (where there is one)
+    upper = False
     if coalesce:
-        upper = False
         for i in range(k):
             upper = upper or v[i].imag > 0
-        for i in range(k):
-            half[i] = not upper or v[i].imag >= 0
     if undamped or coalesce:
         s1 = 0j
         s2 = 0j
         m = 0
         for i in range(k):
-            if half[i]:
+            if not upper or v[i].imag >= 0:
                 s1 += v[i]
                 s2 += v[i] * v[i]
                 m += 1
@@ -230,7 +248,6 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
     if not derivative:
         return f, 0.0, True
     n = vecs.shape[0]
-    b = np.empty(k, dtype=np.complex128)
     for i in range(k):
         c0 = sel[i]
         acc = 0j
@@ -275,7 +292,7 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
     svb = 0j
     m = 0
     for i in range(k):
-        if half[i]:
+        if not upper or v[i].imag >= 0:
             s1 += v[i]
             sb += b[i]
             svb += v[i] * b[i]
@@ -479,6 +496,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
     sel = np.empty(n, dtype=np.int64)
     cols = np.empty(n, dtype=np.int64)
     share = np.empty(n)
+    work = np.empty((3, n), dtype=np.complex128)
     members = np.empty(n, dtype=np.bool_)
     cplx = np.empty((1, n), dtype=np.bool_)
     neg = np.empty((1, n), dtype=np.bool_)
@@ -552,7 +570,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                     if code_a == PROVIDER_ERROR:
                         failed = True
                         break
-                    ok_a = code_a != NOT_FINITE and select(cache[3][sa], vc, wc, k, sel, share)
+                    ok_a = code_a != NOT_FINITE and select(cache[3][sa], vc, wc, k, sel, share, work[0])
                     while unique and ok_a:  # the exact route (a loop only to leave it early)
                         target = 0.0
                         coalesce = False
@@ -567,7 +585,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
-                                if code == NOT_FINITE or not select(cache[3][s], vc, wc, k, sel, share):
+                                if code == NOT_FINITE or not select(cache[3][s], vc, wc, k, sel, share, work[0]):
                                     marginal = False
                                     break
                                 for i in range(k):
@@ -597,7 +615,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 break
                             slope = (newton or copies) and code == OK
                             f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
-                                                  divergence, target, slope, sel, share, coalesce)
+                                                  divergence, target, slope, sel, share, work, coalesce)
                             clear = clear and code != NOT_FINITE and ok
                             fab[e] = f
                             if slope:
@@ -624,7 +642,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 if code != OK:
                                     break
                                 f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc,
-                                                      k, divergence, 0.0, with_slope, sel, share, coalesce)
+                                                      k, divergence, 0.0, with_slope, sel, share, work, coalesce)
                                 if not ok:
                                     break
                                 p, done = newton_step(st, p, f, df)
@@ -646,7 +664,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                     failed = True
                                     break
                                 f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
-                                                     divergence, target, without_slope, sel, share, coalesce)
+                                                     divergence, target, without_slope, sel, share, work, coalesce)
                                 if code == NOT_FINITE or not ok:
                                     break
                         break
@@ -660,7 +678,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
-                        select(cache[3][s], vc, wc, k, sel, share)
+                        select(cache[3][s], vc, wc, k, sel, share, work[0])
                         cols[:k] = sel[:k]
                         shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
                         vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
@@ -669,7 +687,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
-                        if code != NOT_FINITE and select(cache[3][s], vc, wc, k, sel, share):
+                        if code != NOT_FINITE and select(cache[3][s], vc, wc, k, sel, share, work[0]):
                             shapes, values = _take(cache[2][s], cache[3][s], sel, k, n_dof)
                         break
                     if step_back:
