@@ -141,7 +141,11 @@ def _run(jobs: Jobs, n_dof: int, all_crossings: bool):
     count = len(jobs.ints)
     if count > 2:
         require_compiled()  # a stack of designs: compiled from its first problem
-    onsets = np.full((count, 2 * jobs.grids.shape[1], 7), np.nan)
+    # rows for the brackets: every crossing (at most two per grid interval: a bubble's loss and
+    # regain), or for the first loss alone the one bracket the scan stops at (and a spare); a
+    # study's stack of 1e4 designs would otherwise allocate 18 MB here for 2 rows used
+    rows = 2 * jobs.grids.shape[1] if all_crossings else 2
+    onsets = np.full((count, rows, 7), np.nan)
     counts = np.zeros((count, 8), dtype=np.int64)
     mode = np.zeros((count, n_dof), dtype=np.complex128)
     part = np.zeros((count, n_dof))
