@@ -71,10 +71,10 @@ def _least_gap(sorted_, n, tol_duplicate):
     return gap
 
 
-@njit(cache=True, error_model="numpy")
-def _indicators(vals, undamped, cplx, neg, tol_duplicate, unstable, indicator):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _indicators(vals, undamped, cplx, neg, tol_duplicate, unstable, indicator, re):
+    """Whether each row of ``vals`` is unstable, and its scan indicators; ``re (n,)`` is work space."""
     count, n = vals.shape
-    re = np.empty(n)
     for s in range(count):
         any_c = False
         bad = False
@@ -129,5 +129,5 @@ def classify_eigenvalues(vals: NDArray[np.complex128], undamped: bool, tol_unsta
     cplx, neg = unstable_masks(vals, undamped, tol_unstable, tol_cluster, floor)
     unstable = np.empty(len(vals), dtype=np.bool_)
     indicator = np.empty((len(vals), 2))
-    _indicators(vals, bool(undamped), cplx, neg, float(tol_duplicate), unstable, indicator)
+    _indicators(vals, bool(undamped), cplx, neg, float(tol_duplicate), unstable, indicator, np.empty(vals.shape[-1]))
     return unstable, indicator

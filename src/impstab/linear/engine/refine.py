@@ -555,7 +555,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                     if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
                         failed = True
                         break
-                    _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
+                    _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg, ws[13])
                     if one_flag[0]:
                         b = mid
                     else:
@@ -703,7 +703,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
                     failed = True
                     break
-                _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg)
+                _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg, ws[13])
                 counts[j, BISECTIONS] += 1
                 if one_flag[0]:
                     b = mid

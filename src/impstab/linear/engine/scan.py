@@ -37,14 +37,15 @@ _GOLDEN = 0.5 * (3.0 - float(np.sqrt(5.0)))
 _MAXFUN = 500
 
 
-@njit(cache=True, error_model="numpy")
-def _classify(vals, lost, undamped, flags, ind, cplx, neg):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _classify(vals, lost, undamped, flags, ind, cplx, neg, work):
     """Stability flags and the bubble indicators ``(m, 2)`` from the eigenvalues ``vals (m, N)``.
 
     A load without a finite operator (``lost``: no static equilibrium) is unstable, indicators -inf.
+    ``work (N,)`` is work space.
     """
     _masks(vals, undamped, TOL_UNSTABLE, TOL_CLUSTER, FLOOR, cplx, neg)
-    _indicators(vals, undamped, cplx, neg, TOL_DUPLICATE, flags, ind)
+    _indicators(vals, undamped, cplx, neg, TOL_DUPLICATE, flags, ind, work)
     for i in range(len(lost)):
         if lost[i]:
             flags[i] = True
@@ -326,7 +327,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                         failed = True
                         break
                     m = stop - known
-                    _classify(ws[10][:m], ws[11][:m], undamped, flags[known:stop], ind[known:stop], cplx[:m], neg[:m])
+                    _classify(ws[10][:m], ws[11][:m], undamped, flags[known:stop], ind[known:stop], cplx[:m], neg[:m], ws[13])
                     vals_grid[known:stop] = ws[10][:m]
                     known = stop
                 if failed or flags[0]:
@@ -392,7 +393,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
-                        _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx[:1], neg[:1])
+                        _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx[:1], neg[:1], ws[13])
                         if one_flag[0]:
                             hit = probe[0]
                             break

@@ -127,7 +127,8 @@ def _lapack_vectors(op, vals, vecs, inv):
 
 @njit(cache=True, error_model="numpy")
 def workspace(n, chunk):
-    """Work arrays of :func:`spectrum` for operators of order ``n``, up to ``chunk`` loads a call."""
+    """Work arrays of :func:`spectrum` for operators of order ``n``, up to ``chunk`` loads a call
+    (and, last, ``n`` floats of scratch for the classification of its eigenvalues)."""
     order = np.arange(n).reshape(1, n)
     starts = np.full((1, n + 1), n, dtype=np.int64)
     starts[0, 0] = 0
@@ -135,7 +136,7 @@ def workspace(n, chunk):
     return (eig_workspace(n), np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n),
             np.empty((chunk, n, n)), np.zeros((1, n, n)), order, starts, np.ones(1, dtype=np.int64),
             np.empty((chunk, n), dtype=np.complex128), np.empty(chunk, dtype=np.bool_),
-            np.zeros((1, n), dtype=np.int64))
+            np.zeros((1, n), dtype=np.int64), np.empty(n))
 
 
 @njit(cache=True, error_model="numpy")
