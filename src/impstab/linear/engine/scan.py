@@ -305,6 +305,8 @@ def scan_stack(jobs, all_crossings, onsets, counts):
     pair_ws = (np.empty((n, n)), np.empty((n, n)), np.empty(n, dtype=np.int64), np.empty(n), np.empty(n),
                np.empty(n), np.empty(n))
     counter = np.zeros(3, dtype=np.int64)
+    # the one-point views made once, not in the loops (each view made costs two atomic reference counts)
+    vals1, lost1, cplx1, neg1, scratch = ws[10][:1], ws[11][:1], cplx[:1], neg[:1], ws[13]
     for j in range(count):
         cache[0][:] = np.nan  # a new problem: nothing cached
         counter[:] = 0
@@ -327,7 +329,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                         failed = True
                         break
                     m = stop - known
-                    _classify(ws[10][:m], ws[11][:m], undamped, flags[known:stop], ind[known:stop], cplx[:m], neg[:m], ws[13])
+                    _classify(ws[10][:m], ws[11][:m], undamped, flags[known:stop], ind[known:stop], cplx[:m], neg[:m], scratch)
                     vals_grid[known:stop] = ws[10][:m]
                     known = stop
                 if failed or flags[0]:
@@ -393,7 +395,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
-                        _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx[:1], neg[:1], ws[13])
+                        _classify(vals1, lost1, undamped, one_flag, one_ind, cplx1, neg1, scratch)
                         if one_flag[0]:
                             hit = probe[0]
                             break
