@@ -508,6 +508,10 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
     point = np.zeros(1)
     st = np.zeros(8)
     ev = np.zeros(3, dtype=np.int64)
+    # the cache's arrays and the one-point views taken once, not in the loops (each taken costs two
+    # atomic reference counts)
+    c_vals, c_vecs, c_inv = cache[2], cache[3], cache[4]
+    vals1, lost1, scratch = ws[10][:1], ws[11][:1], ws[13]
     for j in range(len(jobs.ints)):
         if counts[j, STATUS] != 0:
             continue
@@ -555,22 +559,22 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                     if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
                         failed = True
                         break
-                    _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg, ws[13])
+                    _classify(vals1, lost1, undamped, one_flag, one_ind, cplx, neg, scratch)
                     if one_flag[0]:
                         b = mid
                     else:
                         a = mid
                     continue
-                found, unique, divergence = unstable_cluster(cache[2][sb], undamped, members, cplx, neg)
+                found, unique, divergence = unstable_cluster(c_vals[sb], undamped, members, cplx, neg)
                 step_back = False
                 if found and code_b == OK:
-                    k = projector(cache[3][sb], cache[4][sb], members, vc, wc)
+                    k = projector(c_vecs[sb], c_inv[sb], members, vc, wc)
                     point[0] = a
                     code_a, sa = spectrum(jobs, j, point, True, cache, ws, ev)
                     if code_a == PROVIDER_ERROR:
                         failed = True
                         break
-                    ok_a = code_a != NOT_FINITE and select(cache[3][sa], vc, wc, k, sel, share, work[0])
+                    ok_a = code_a != NOT_FINITE and select(c_vecs[sa], vc, wc, k, sel, share, work[0])
                     while unique and ok_a:  # the exact route (a loop only to leave it early)
                         target = 0.0
                         coalesce = False
@@ -585,11 +589,11 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
-                                if code == NOT_FINITE or not select(cache[3][s], vc, wc, k, sel, share, work[0]):
+                                if code == NOT_FINITE or not select(c_vecs[s], vc, wc, k, sel, share, work[0]):
                                     marginal = False
                                     break
                                 for i in range(k):
-                                    if abs(_relative_real(cache[2][s][sel[i]])) > TOL_MARGINAL:
+                                    if abs(_relative_real(c_vals[s][sel[i]])) > TOL_MARGINAL:
                                         marginal = False
                                 if not marginal:
                                     break
@@ -614,7 +618,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 failed = True
                                 break
                             slope = (newton or copies) and code == OK
-                            f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
+                            f, df, ok = indicator(c_vals[s], c_vecs[s], c_inv[s], a1, undamped, vc, wc, k,
                                                   divergence, target, slope, sel, share, work, coalesce)
                             clear = clear and code != NOT_FINITE and ok
                             fab[e] = f
@@ -641,7 +645,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                     break
                                 if code != OK:
                                     break
-                                f, df, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc,
+                                f, df, ok = indicator(c_vals[s], c_vecs[s], c_inv[s], a1, undamped, vc, wc,
                                                       k, divergence, 0.0, with_slope, sel, share, work, coalesce)
                                 if not ok:
                                     break
@@ -663,7 +667,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
-                                f, _, ok = indicator(cache[2][s], cache[3][s], cache[4][s], a1, undamped, vc, wc, k,
+                                f, _, ok = indicator(c_vals[s], c_vecs[s], c_inv[s], a1, undamped, vc, wc, k,
                                                      divergence, target, without_slope, sel, share, work, coalesce)
                                 if code == NOT_FINITE or not ok:
                                     break
@@ -678,17 +682,17 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
-                        select(cache[3][s], vc, wc, k, sel, share, work[0])
+                        select(c_vecs[s], vc, wc, k, sel, share, work[0])
                         cols[:k] = sel[:k]
-                        shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
-                        vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
+                        shapes, values = _take(c_vals[s], c_vecs[s], cols, k, n_dof)
+                        vals_r, vecs_r = c_vals[s].copy(), c_vecs[s].copy()
                         point[0] = a
                         code, s = spectrum(jobs, j, point, True, cache, ws, ev)
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
-                        if code != NOT_FINITE and select(cache[3][s], vc, wc, k, sel, share, work[0]):
-                            shapes, values = _take(cache[2][s], cache[3][s], sel, k, n_dof)
+                        if code != NOT_FINITE and select(c_vecs[s], vc, wc, k, sel, share, work[0]):
+                            shapes, values = _take(c_vals[s], c_vecs[s], sel, k, n_dof)
                         break
                     if step_back:
                         new_a = min(max(a + (a - b), lo_lim), hi_lim)
@@ -703,7 +707,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
                     failed = True
                     break
-                _classify(ws[10][:1], ws[11][:1], undamped, one_flag, one_ind, cplx, neg, ws[13])
+                _classify(vals1, lost1, undamped, one_flag, one_ind, cplx, neg, scratch)
                 counts[j, BISECTIONS] += 1
                 if one_flag[0]:
                     b = mid
@@ -726,14 +730,14 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 if code == PROVIDER_ERROR:
                     failed = True
                     break
-                found, _, divergence = unstable_cluster(cache[2][s], undamped, members, cplx, neg)
+                found, _, divergence = unstable_cluster(c_vals[s], undamped, members, cplx, neg)
                 k = np.int64(0)
                 for i in range(n):
                     if members[i]:
                         cols[k] = i
                         k += 1
-                shapes, values = _take(cache[2][s], cache[3][s], cols, k, n_dof)
-                vals_r, vecs_r = cache[2][s].copy(), cache[3][s].copy()
+                shapes, values = _take(c_vals[s], c_vecs[s], cols, k, n_dof)
+                vals_r, vecs_r = c_vals[s].copy(), c_vecs[s].copy()
             if affine or jobs.ints[j, KEY] < 0:
                 weights[:] = jobs.weights[j]
             elif provided_weights(jobs.ints[j, KEY], root, weights) != 0:
