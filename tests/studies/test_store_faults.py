@@ -324,3 +324,40 @@ def test_a_store_with_nothing_finished_is_not_left_behind(reference, tmp_path, m
     assert "nothing was kept" in one_line(capsys.readouterr().err)
     assert not list(tmp_path.iterdir())
     time.sleep(0)
+
+
+@pytest.mark.parametrize("after", ["rename", "hand-over"])
+def test_ctrl_c_as_a_new_store_is_made_leaves_nothing(tmp_path, monkeypatch, after):
+    """A SIGINT that arrives right after the new store is renamed into place, or between its
+    creation and the run holding it, is raised once the run holds the store, which it removes (no
+    chunk was computed): no store without a run in its history, no temporary folder."""
+    import signal
+
+    from impstab.studies.store import StudyStore
+
+    study = load_study(write_study(tmp_path, FAULT_STUDY, chunk_size=5))
+    made = StudyStore._create.__func__
+
+    def interrupted(cls, *args, **kw):
+        if after == "rename":
+            real = os.rename
+
+            def rename_then_interrupt(src, dst):
+                real(src, dst)
+                signal.raise_signal(signal.SIGINT)
+
+            monkeypatch.setattr(os, "rename", rename_then_interrupt)
+        store = made(cls, *args, **kw)
+        monkeypatch.undo()
+        if after == "hand-over":
+            signal.raise_signal(signal.SIGINT)
+        return store
+
+    monkeypatch.setattr(StudyStore, "_create", classmethod(interrupted))
+    with pytest.raises(KeyboardInterrupt):
+        run_study(study, tmp_path / "s.zarr", report=lambda line: None)
+    assert not (tmp_path / "s.zarr").exists()
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".s.zarr")]
+    res = run_study(study, tmp_path / "s.zarr", report=lambda line: None)  # and a new run makes it afresh
+    assert res.complete
+    assert [e["interrupted"] for e in json.loads(open_study(tmp_path / "s.zarr").dataset.attrs["history"])] == [False]

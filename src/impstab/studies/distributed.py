@@ -31,6 +31,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .evaluate import ChunkTask, evaluate_chunk
+from .interrupts import interrupt_held
 from .plan import ChunkPlan
 
 __all__ = ["local_cluster", "connect", "start_local", "run_on_dask", "Session", "StoreTarget", "run_chunks",
@@ -63,22 +64,12 @@ def _silent(interrupt_after: bool = False):
     levels = {n: logging.getLogger(n).level for n in _LOGGERS}
     for n in _LOGGERS:
         logging.getLogger(n).setLevel(logging.CRITICAL + 1)
-    main = threading.current_thread() is threading.main_thread()
-    caught: list[int] = []
-    previous = signal.signal(signal.SIGINT, lambda sig, frame: caught.append(sig)) if main else None
     try:
-        yield
-    except BaseException:
-        if caught and interrupt_after:
-            raise KeyboardInterrupt from None  # what broke the block was the interrupt
-        raise
+        with interrupt_held(interrupt_after):
+            yield
     finally:
-        if main:
-            signal.signal(signal.SIGINT, previous)
         for n, level in levels.items():
             logging.getLogger(n).setLevel(level)
-    if caught and interrupt_after:
-        raise KeyboardInterrupt
 
 
 def _ignore_interrupt() -> None:

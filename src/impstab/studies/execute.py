@@ -28,6 +28,7 @@ from typing import Callable
 from ..errors import ModelError
 from ..io import output_error
 from .evaluate import ChunkTask, evaluate_chunk
+from .interrupts import interrupt_held
 from .plan import ChunkPlan, plan_chunks
 from .result import StudyResult
 from .store import StudyStore
@@ -126,23 +127,26 @@ def run_study(
         from .distributed import connect
 
         session = connect(scheduler)  # before anything is written: a wrong address leaves nothing behind
-    try:
-        st = StudyStore.create_or_resume(study, plan, store)
-    except BaseException:
-        if session is not None:
-            session.close()
-        raise
     owned = [session] if session is not None else []
+    st = None
+    # a new store is made with Ctrl-C held back: an interrupt is raised once this run holds the
+    # store (and removes it below), not between its creation and the hand-over, which would leave
+    # behind a store without a run in its history ("chunks kept" where none was computed)
+    creating = store is not None and not os.path.lexists(store)
     try:
+        with interrupt_held() if creating else contextlib.nullcontext():
+            st = StudyStore.create_or_resume(study, plan, store)
         for line in st.findings:
             say(line)
         return _run(study, plan, st, workers, scheduler, client, owned, progress, say, in_process_below)
     except BaseException:
         _close(owned)  # the workers stopped first: nothing writes into the store any more
-        st.discard()  # a store made by this run with no chunk finished: nothing to resume, nothing left
+        if st is not None:
+            st.discard()  # a store made by this run with no chunk finished: nothing to resume, nothing left
         raise
     finally:
-        st.close()
+        if st is not None:
+            st.close()
         _close(owned)
 
 
