@@ -249,8 +249,8 @@ def _run_local(study: Study, plan: ChunkPlan, st: StudyStore, todo: list[int], d
     rest = list(todo)
     if not progress:
         while rest and not stop():
-            st.write(evaluate_chunk(chunk_task(study, plan, rest[0])))
-            done(rest.pop(0))
+            _keep(st, evaluate_chunk(chunk_task(study, plan, rest[0])), done)
+            rest.pop(0)
         return rest
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, ProgressColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
@@ -267,7 +267,18 @@ def _run_local(study: Study, plan: ChunkPlan, st: StudyStore, todo: list[int], d
         job = bar.add_task("designs", total=sum(_prod(plan.block_shape(i)) for i in todo))
         while rest and not stop():
             index = rest.pop(0)
-            st.write(evaluate_chunk(chunk_task(study, plan, index)))
-            done(index)
+            _keep(st, evaluate_chunk(chunk_task(study, plan, index)), done)
             bar.advance(job, _prod(plan.block_shape(index)))
     return rest
+
+
+def _keep(st: StudyStore, result, done: Callable) -> None:
+    """Write a computed chunk (its data, then its completion record) and count it, Ctrl-C held back.
+
+    The write takes milliseconds. Cut half-way by an interrupt, zarr's asynchronous writes were left
+    never awaited, a warning each when the process ended (the interrupted run's one line on
+    stderr became five), and a chunk written but not counted was missing from the run's history.
+    """
+    with interrupt_held():
+        st.write(result)
+        done(result.index)
