@@ -27,7 +27,7 @@ from typing import Callable
 
 from ..errors import ModelError
 from ..io import output_error
-from .evaluate import ChunkTask, evaluate_chunk
+from .evaluate import ChunkResult, ChunkTask, evaluate_chunk
 from .interrupts import interrupt_held
 from .plan import ChunkPlan, plan_chunks
 from .result import StudyResult
@@ -272,7 +272,7 @@ def _run_local(study: Study, plan: ChunkPlan, st: StudyStore, todo: list[int], d
     return rest
 
 
-def _keep(st: StudyStore, result, done: Callable) -> None:
+def _keep(st: StudyStore, result: ChunkResult, done: Callable[[int], None]) -> None:
     """Write a computed chunk (its data, then its completion record) and count it, Ctrl-C held back.
 
     The write takes milliseconds. Cut half-way by an interrupt, zarr's asynchronous writes were left
