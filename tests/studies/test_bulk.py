@@ -158,3 +158,37 @@ def test_a_bulk_design_that_needs_its_own_engine_builds_its_model():
             assert np.isnan(got.thrust[j])
         else:
             assert abs(got.thrust[j] - ref.thrust) <= 1e-10 * ref.thrust
+
+
+def test_postcritical_outputs_of_designs_assembled_in_bulk_are_those_of_their_models():
+    # the post-critical analysis needs the model: a design assembled in bulk is built as one for it
+    # (it raised AttributeError on the matrices alone)
+    from impstab.postcritical import propulsor_postcritical
+
+    base = _mixed_base()
+    segs = [("mount_rings", 0, "k_axial"), ("mount_rings", 0, "k_shear")]
+    cols = [np.array([3e4, 1e5]), np.array([1e4, 2e4])]  # both flutter (checked below)
+    assert len(assemble_bulk(base, segs, cols).stack) == 2
+    got = evaluate_chunk(ChunkTask(0, (2,), base, tuple(segs), tuple(cols),
+                                   ("critical_thrust", "lyapunov_coefficient", "bifurcation")))
+    assert (got.data["status"] == 0).all()
+    for j in range(2):
+        ref = propulsor_postcritical(model_from_dict(variant_dict(base, segs, [c[j] for c in cols])), branch=False)
+        # undamped (as every design assembled in bulk): the merging of two frequencies, no Hopf point
+        assert ref.bifurcation == "degenerate" and ref.lyapunov_coefficient is None
+        assert got.data["bifurcation"][j] == ref.bifurcation
+        assert np.isnan(got.data["lyapunov_coefficient"][j])
+        assert got.data["critical_thrust"][j] == pytest.approx(ref.critical_thrust, rel=1e-9)
+
+
+def test_a_stack_and_separate_designs_in_one_batch():
+    # the study's stacked designs and AffineDesign entries of the same batch are one stack
+    base = _mixed_base()
+    segs, cols = _columns(np.random.default_rng(6), 4)
+    bulk = assemble_bulk(base, segs, cols)
+    mixed = [None, None] + bulk.designs[2:]
+    got = critical_thrust_batch(mixed, affine=bulk.stack.take(slice(0, 2)))
+    ref = critical_thrust_batch(bulk.designs)
+    np.testing.assert_array_equal(got.status, 0)
+    np.testing.assert_array_equal(got.thrust, ref.thrust)
+    np.testing.assert_array_equal(got.kind, ref.kind)

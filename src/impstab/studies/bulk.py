@@ -23,13 +23,13 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..limits import RANGES
-from ..linear.batch import AffineDesign
+from ..linear.batch import AffineDesign, AffineStack
 from ..linear.linearize import ModelFamily, affine_forms, pack_model
 from ..model.assemble import model_from_dict, unit_vector
 from ..model.mounts import axial_shear_matrix, condense, ring_positions
@@ -57,11 +57,27 @@ class BulkDesigns:
 
     Attributes
     ----------
-    designs : list of AffineDesign or None
-        One entry per design of the chunk; None: the design takes the per-variant path.
+    stack : AffineStack
+        The matrices of the designs assembled here (``stack.rows``: their positions in the
+        chunk), as :func:`~impstab.linear.batch.critical_thrust_batch` takes them.
+    size : int
+        Designs in the chunk; those not in ``stack.rows`` take the per-variant path.
     """
 
-    designs: list[AffineDesign | None]
+    stack: AffineStack
+    size: int
+    _factory: Callable[[int], ModelFamily]
+
+    @functools.cached_property
+    def designs(self) -> list[AffineDesign | None]:
+        """One entry per design of the chunk: its :class:`AffineDesign`, or None for the
+        per-variant path (built on first access; the study itself uses :attr:`stack`)."""
+        out: list[AffineDesign | None] = [None] * self.size
+        st = self.stack
+        for k, j in enumerate(st.rows.tolist()):
+            out[j] = AffineDesign(st.mass[k], st.k0[k], st.k1[k], float(st.thrust_max[k]), float(st.operating[k]),
+                                  functools.partial(self._factory, j))
+        return out
 
 
 def _eligible(segments: Sequence[tuple]) -> bool:
@@ -171,14 +187,10 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
     )
     if not affine.all():
         good, mass, k0, k1 = good[affine], mass[affine], k0[affine], k1[affine]
-    designs: list[AffineDesign | None] = [None] * n
-    for j, mj, k0j, k1j, tj, oj in zip(
-        good.tolist(), mass, k0, k1, thrust_max[good].tolist(), operating[good].tolist()
-    ):
-        designs[j] = AffineDesign(mj, k0j, k1j, tj, oj, functools.partial(_variant_family, base, segments, columns, j, name))
-    return BulkDesigns(designs)
+    stack = AffineStack(good.astype(np.intp), mass, k0, k1, thrust_max[good], operating[good])
+    return BulkDesigns(stack, n, functools.partial(_variant_family, base, segments, columns, name=name))
 
 
-def _variant_family(base: dict, segments, columns, j: int, name: str) -> ModelFamily:
+def _variant_family(base: dict, segments, columns, j: int, *, name: str) -> ModelFamily:
     """The family of design ``j``, assembled the per-variant way (only if its engine is needed)."""
     return ModelFamily(model_from_dict(variant_dict(base, segments, [c[j] for c in columns]), name=name))

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from .._jit import require_compiled
 from ..errors import ModelError
-from ..linear.batch import STATUSES, AffineDesign, critical_thrust_batch
+from ..linear.batch import STATUSES, critical_thrust_batch
 from ..model.assemble import model_from_dict
 from .bulk import assemble_bulk
 from .isolation import IsolationSettings, isolation_outputs
@@ -107,22 +107,19 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
     t0 = time.perf_counter()
     n = len(task.columns[0]) if task.columns else 1
     bulk = assemble_bulk(task.base_model, task.segments, task.columns, task.model_name)
-    models: list = []
+    in_bulk = np.zeros(n, dtype=bool)
+    if bulk is not None:
+        in_bulk[bulk.stack.rows] = True
+    models: list = [None] * n
     errors: dict[int, str] = {}
-    for j in range(n):
-        if bulk is not None and bulk.designs[j] is not None:
-            models.append(bulk.designs[j])
-            continue
-        d = variant_dict(task.base_model, task.segments, [c[j] for c in task.columns])
+    for j in np.flatnonzero(~in_bulk).tolist():
         try:
-            models.append(model_from_dict(d, name=task.model_name))
+            models[j] = _variant(task, j)
         except ModelError as exc:
-            models.append(None)
             errors[j] = str(exc)
         except Exception as exc:  # noqa: BLE001 - a variant never stops the study
-            models.append(None)
             errors[j] = f"{type(exc).__name__}: {exc}"
-    res = critical_thrust_batch(models)
+    res = critical_thrust_batch(models, affine=None if bulk is None else bulk.stack)
     status = res.status.copy()
     message = list(res.message)
     for j, text in errors.items():
@@ -144,11 +141,11 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
     }
     iso_names = tuple(n for n in task.outputs if n in ISOLATION_OUTPUTS
                       or (task.isolation is not None and any(p.name == n for p in task.isolation.at)))
+    if iso_names or any(name in POSTCRITICAL_OUTPUTS for name in task.outputs):
+        # the designs assembled in bulk as models too: these outputs need the model's view
+        models = [_variant(task, j) if in_bulk[j] else m for j, m in enumerate(models)]
     if iso_names:
-        full = [m if m is None or not isinstance(m, AffineDesign) else
-                model_from_dict(variant_dict(task.base_model, task.segments, [c[j] for c in task.columns]), name=task.model_name)
-                for j, m in enumerate(models)]
-        iso, iso_messages = isolation_outputs(full, task.isolation, iso_names)
+        iso, iso_messages = isolation_outputs(models, task.isolation, iso_names)
         values.update(iso)
         for j, text in iso_messages.items():
             if status[j] == 0:
@@ -171,6 +168,12 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
     data["status"] = status.astype(np.int8).reshape(task.block)
     data["message"] = np.array(message, dtype=np.str_).reshape(task.block)
     return ChunkResult(task.index, data, time.perf_counter() - t0, res.evaluations)
+
+
+def _variant(task: ChunkTask, j: int):
+    """The model of design ``j`` of the chunk, from its variant model file (raises ``ModelError``)."""
+    return model_from_dict(variant_dict(task.base_model, task.segments, [c[j] for c in task.columns]),
+                           name=task.model_name)
 
 
 def _postcritical(models, res, failed, message, branch: bool) -> dict[str, object]:

@@ -13,7 +13,7 @@ from ..engine import Problem, StackOutcome, second_order_problem, solve, solve_a
 from ..engine.problems import mass_solve
 from ..linearize import ModelFamily
 from ..practical import practical_onset, practical_problem
-from .results import KINDS, STATUSES, AffineDesign, BatchCriticalThrust
+from .results import KINDS, STATUSES, AffineDesign, AffineStack, BatchCriticalThrust
 
 Array = NDArray[np.float64]
 
@@ -26,17 +26,25 @@ def _single(model: Model) -> tuple:
     return (r.thrust, r.kind, r.omega, r.participation, r.warnings), (r.undamped_thrust, r.undamped_kind), r.practical_thrust
 
 
-def _affine_stack(designs: list[AffineDesign], n_scan: int, vectorized: bool):
+def _affine_stack(stack: AffineStack, n_scan: int, vectorized: bool):
     """The undamped problems ``M^-1 K0 + T M^-1 K1`` of designs given by their matrices, solved at once."""
-    m = np.stack([d.mass for d in designs])
-    a0, a1 = np.moveaxis(mass_solve(m, np.stack([[d.k0, d.k1] for d in designs])), 1, 0)
-    weights = np.diagonal(m, axis1=1, axis2=2)
-    t_max = np.array([d.thrust_max for d in designs], dtype=float)
+    a0, a1 = np.moveaxis(mass_solve(stack.mass, np.stack([stack.k0, stack.k1], axis=1)), 1, 0)
+    weights = np.diagonal(stack.mass, axis1=1, axis2=2)
+    t_max = np.asarray(stack.thrust_max, dtype=float)
     if vectorized:
         return solve_affine(a0, a1, weights, t_max, n_scan=n_scan)
     parts = [solve_affine(a0[i:i + 1], a1[i:i + 1], weights[i:i + 1], t_max[i:i + 1], n_scan=n_scan)
-             for i in range(len(designs))]
+             for i in range(len(stack))]
     return _joined(parts)
+
+
+def _affine_designs(models: Sequence, given: AffineStack | None) -> AffineStack | None:
+    """One stack of every design given by its matrices: ``given`` and the :class:`AffineDesign` entries."""
+    listed = [i for i, m in enumerate(models) if isinstance(m, AffineDesign)]
+    if not listed:
+        return given
+    own = AffineStack.of(listed, [models[i] for i in listed])
+    return own if given is None else AffineStack.joined([given, own])
 
 
 def _joined(parts: list[StackOutcome]) -> StackOutcome:
@@ -54,7 +62,8 @@ def _mode_names(participation: Array) -> list[str]:
 
 
 def critical_thrust_batch(
-    models: Sequence[Model | AffineDesign | None], *, n_scan: int = 64, chunk: int = 16, vectorized: bool = True
+    models: Sequence[Model | AffineDesign | None], *, affine: AffineStack | None = None, n_scan: int = 64,
+    chunk: int = 16, vectorized: bool = True,
 ) -> BatchCriticalThrust:
     """Critical thrust of every model, as :func:`impstab.critical_thrust` gives it for one.
 
@@ -64,6 +73,10 @@ def critical_thrust_batch(
         The designs; None marks a design to skip (status ``"invalid"``, empty message, for the
         caller to fill in). An :class:`AffineDesign` (matrices of an undamped affine design,
         assembled in bulk by a design study) is searched exactly as its model would be.
+    affine : AffineStack, optional
+        More designs given by their matrices, stacked, at positions ``affine.rows`` of the batch
+        (the entries of ``models`` there are None): a chunk of a design study assembled in bulk,
+        with no object per design.
     n_scan : int
         Scan intervals.
     chunk : int
@@ -90,29 +103,28 @@ def critical_thrust_batch(
     bases: dict[int, Problem] = {}
     done: dict[int, tuple] = {}
     affine_evaluations = decompositions = pairs = 0
-    affine = [i for i, m in enumerate(models) if isinstance(m, AffineDesign)]
-    if affine:
-        for i in affine:
-            out["t_max"][i], out["operating"][i] = models[i].thrust_max, models[i].operating
-        rows, stack = affine, None
+    given = _affine_designs(models, affine)
+    if given is not None and len(given):
+        out["t_max"][given.rows], out["operating"][given.rows] = given.thrust_max, given.operating
+        rows, stack = given.rows, None
         try:
-            stack = _affine_stack([models[i] for i in affine], n_scan, vectorized)
+            stack = _affine_stack(given, n_scan, vectorized)
         except np.linalg.LinAlgError:  # a singular mass somewhere: design by design
-            rows, parts = [], []
-            for i in affine:
+            kept, parts = [], []
+            for k, i in enumerate(given.rows.tolist()):
                 try:
-                    parts.append(_affine_stack([models[i]], n_scan, True))
-                    rows.append(i)
+                    parts.append(_affine_stack(given.take(slice(k, k + 1)), n_scan, True))
+                    kept.append(i)
                 except Exception as exc:  # noqa: BLE001 - reported per design
                     status[i], message[i] = _failure(exc)
+            rows = np.array(kept, dtype=np.intp)
             if parts:
                 stack = _joined(parts)
         if stack is not None:
-            idx = np.array(rows)
-            out["thrust"][idx], out["omega"][idx], kind[idx] = stack.load, stack.omega, stack.kind
-            out["undamped"][idx], ukind[idx] = stack.load, stack.kind
-            status[idx] = 0
-            for i, names, warn in zip(rows, _mode_names(stack.participation), stack.warnings):
+            out["thrust"][rows], out["omega"][rows], kind[rows] = stack.load, stack.omega, stack.kind
+            out["undamped"][rows], ukind[rows] = stack.load, stack.kind
+            status[rows] = 0
+            for i, names, warn in zip(rows.tolist(), _mode_names(stack.participation), stack.warnings):
                 modes[i], message[i] = names, "; ".join(warn)
             affine_evaluations = int(stack.evaluations.sum())
             decompositions, pairs = int(stack.decompositions.sum()), int(stack.pairs.sum())

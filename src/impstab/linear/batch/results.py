@@ -44,6 +44,55 @@ class AffineDesign:
 
 
 @dataclass(frozen=True, eq=False)
+class AffineStack:
+    """Designs given by their matrices, stacked: each undamped, non-gyroscopic, ``K = K0 + T K1``.
+
+    The form in which a design study's bulk assembly hands a chunk's designs to
+    :func:`~impstab.linear.batch.critical_thrust_batch` (its ``affine`` argument): the engine
+    takes the stacks as they are, with no object per design.
+
+    Attributes
+    ----------
+    rows : (J,) int array
+        The designs' positions in the batch.
+    mass, k0, k1 : (J, 6, 6) arrays
+        ``M`` (kg, kg m, kg m^2), ``K0`` and ``K1`` of each design, as in :class:`AffineDesign`.
+    thrust_max, operating : (J,) arrays
+        End of the thrust search and operating thrust (N; NaN without one).
+    """
+
+    rows: NDArray[np.intp]
+    mass: Array
+    k0: Array
+    k1: Array
+    thrust_max: Array
+    operating: Array
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def take(self, which) -> "AffineStack":
+        """The designs at positions ``which`` of this stack (an index array or a slice)."""
+        return AffineStack(*(np.asarray(getattr(self, f))[which] for f in _STACKED))
+
+    @staticmethod
+    def of(rows, designs: list[AffineDesign]) -> "AffineStack":
+        """The stack of separate :class:`AffineDesign` objects at ``rows`` of the batch."""
+        return AffineStack(np.asarray(rows, dtype=np.intp), np.stack([d.mass for d in designs]),
+                           np.stack([d.k0 for d in designs]), np.stack([d.k1 for d in designs]),
+                           np.array([d.thrust_max for d in designs], dtype=float),
+                           np.array([d.operating for d in designs], dtype=float))
+
+    @staticmethod
+    def joined(parts: list["AffineStack"]) -> "AffineStack":
+        """One stack of the designs of ``parts``, in order."""
+        return AffineStack(*(np.concatenate([getattr(p, f) for p in parts]) for f in _STACKED))
+
+
+_STACKED = ("rows", "mass", "k0", "k1", "thrust_max", "operating")
+
+
+@dataclass(frozen=True, eq=False)
 class BatchCriticalThrust:
     """Critical thrusts of a batch of designs, one entry per design.
 
