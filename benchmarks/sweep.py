@@ -21,8 +21,9 @@ Measured in one run on this machine:
   stiffness), so that the figure for designs the block route cannot help is in the same line.
   Beside it the **compiled eigenvalue floor** (:func:`eigenvalue_floor`): the time of just the
   eigenvalue problems these designs need, with the compiled small-matrix routines, timed in
-  rounds between the sweep's runs (so that both see the machine in the same state), and
-  ``floor_ratio``, the sweep's time per design over it.
+  rounds between the sweep's runs, each about as long as a run (so that both see the machine
+  in the same state, over the same span of time), and ``floor_ratio``, the sweep's time per
+  design over it.
 * **workers** -- the same study on a local Dask cluster (``impstab.studies.execute.local_cluster``)
   of each of ``--workers-list`` worker processes (default 1, 2, 4, 8; one thread each; the
   workers write their own chunks), cluster started and warmed up (one chunk on every worker)
@@ -129,35 +130,43 @@ def loop_time(study, designs: np.ndarray) -> float:
     return (time.perf_counter() - t0) / len(dicts)
 
 
-def eigenvalue_floor(study, designs: np.ndarray):
-    """The compiled eigenvalue floor of the designs: the time of just their eigenvalue problems.
+def eigenvalue_floor(study):
+    """The compiled eigenvalue floor of a study: the time of just its designs' eigenvalue problems.
 
-    The engine's own counts on these designs (bulk-assembled, as the sweep solves them): the
-    eigenproblems with eigenvectors at the compiled decomposition's time (``eig_affine``, per
-    problem on a stack of the designs' operators), every other one -- eigenvalues only, and the
-    pair vectors of the attraction test -- at the compiled eigenvalue routine's
-    (``eigvals_affine_blocks``), a lower bound for the latter. Returns ``time_round``, which times
-    both routines once (call it between the sweep's runs, so that both see the machine in the same
-    state), and ``floor``, which turns the fastest of those rounds into the figures.
+    The engine's own counts on every design of the study (bulk-assembled, as the sweep solves
+    them): the eigenproblems with eigenvectors at the compiled decomposition's time
+    (``eig_affine``), every other one -- eigenvalues only, and the pair vectors of the attraction
+    test -- at the compiled eigenvalue routine's (``eigvals_affine_blocks``), a lower bound for the
+    latter. Each is timed per problem on a stack of the designs' own operators at loads across
+    their range, as many problems per design as the engine solves (rounded up), so that a round
+    of the floor lasts about as long as the engine's part of a sweep. Returns ``time_round``,
+    which times one round (call it between the sweep's runs: both then see the machine in the same
+    state, over the same span of time), and ``floor``, which turns the fastest round into the
+    figures.
     """
     from impstab.linear.batch import critical_thrust_batch
     from impstab.linear.blocks import decoupled_blocks, eig_affine, eigvals_affine_blocks
     from impstab.studies.bulk import assemble_bulk
 
     segs = [p.path.segments for p in study.parameters]
-    idx = np.unravel_index(designs, study.shape)
+    idx = np.unravel_index(np.arange(study.size), study.shape)
     cols = [np.asarray(p.values)[i] for p, i in zip(study.parameters, idx)]
-    bulk = assemble_bulk(study.base_model, segs, cols)
-    models = [d for d in bulk.designs if d is not None]
-    res = critical_thrust_batch(models)
-    a0 = np.stack([np.linalg.solve(d.mass, d.k0) for d in models])
-    a1 = np.stack([np.linalg.solve(d.mass, d.k1) for d in models])
-    t_max = np.array([d.thrust_max for d in models])
+    stack = assemble_bulk(study.base_model, segs, cols).stack
+    res = critical_thrust_batch([None] * study.size, affine=stack)  # the designs not in bulk: skipped
+    designs = len(stack)
+    values_only = res.evaluations - res.decompositions
+    a0, a1 = np.linalg.solve(stack.mass, stack.k0), np.linalg.solve(stack.mass, stack.k1)
+    t_max = stack.thrust_max
     blocks = decoupled_blocks(a0, a1, t_max)
-    loads = t_max[:, None] * np.linspace(0.0, 1.0, 65)[None]
-    mid = 0.5 * t_max
+    n_vals = max(1, int(np.ceil(values_only / designs)))
+    loads = t_max[:, None] * np.linspace(0.0, 1.0, n_vals + 2)[None, 1:-1]
+    n_vecs = max(1, int(np.ceil(res.decompositions / designs)))
+    fractions = np.linspace(0.0, 1.0, n_vecs + 2)[1:-1]
+    b0, b1 = np.concatenate([a0] * n_vecs), np.concatenate([a1] * n_vecs)
+    at = np.concatenate([f * t_max for f in fractions])
+    b_blocks = decoupled_blocks(b0, b1, np.concatenate([t_max] * n_vecs))
     eigvals_affine_blocks(a0, a1, loads, blocks)
-    eig_affine(a0, a1, mid, blocks)
+    eig_affine(b0, b1, at, b_blocks)
     best = [np.inf, np.inf]
 
     def time_round() -> None:
@@ -165,16 +174,15 @@ def eigenvalue_floor(study, designs: np.ndarray):
         eigvals_affine_blocks(a0, a1, loads, blocks)
         best[0] = min(best[0], (time.perf_counter() - t0) / loads.size)
         t0 = time.perf_counter()
-        eig_affine(a0, a1, mid, blocks)
-        best[1] = min(best[1], (time.perf_counter() - t0) / len(models))
+        eig_affine(b0, b1, at, b_blocks)
+        best[1] = min(best[1], (time.perf_counter() - t0) / len(at))
 
     def floor() -> dict:
         t_vals, t_vecs = best
-        values_only = res.evaluations - res.decompositions
-        per_design = (values_only * t_vals + res.decompositions * t_vecs) / len(models)
+        per_design = (values_only * t_vals + res.decompositions * t_vecs) / designs
         return {"floor_us_per_design": per_design * 1e6, "eigenvalue_us": t_vals * 1e6,
-                "decomposition_us": t_vecs * 1e6, "eigenvalue_problems_per_design": values_only / len(models),
-                "decompositions_per_design": res.decompositions / len(models), "designs": len(models)}
+                "decomposition_us": t_vecs * 1e6, "eigenvalue_problems_per_design": values_only / designs,
+                "decompositions_per_design": res.decompositions / designs, "designs": designs}
 
     return time_round, floor
 
@@ -182,10 +190,11 @@ def eigenvalue_floor(study, designs: np.ndarray):
 def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng, repeats: int) -> dict:
     """Sweep and loop on the asymmetric example (classical linearization): no decoupled blocks.
 
-    The sweep's runs alternate with rounds of the eigenvalue floor (the fastest of each counts), so
-    that the ratio compares the two on the machine in the same state: on a shared machine the
-    speed changes by 1.5x within minutes, and a floor timed apart put the ratio anywhere from 1.2x
-    to 2.3x.
+    The sweep's runs alternate with rounds of the eigenvalue floor of the same designs, each
+    round about as long as a run (the fastest of each counts), so that the ratio compares the two
+    on the machine in the same state: on a shared machine the speed changes by 1.5x within
+    minutes; a floor timed apart put the ratio anywhere from 1.2x to 2.3x, and one timed in
+    rounds of a few milliseconds caught quiet moments that no run of a second could.
     """
     text = COUPLED_EXAMPLE.read_text()
     model = tmp / "coupled.toml"
@@ -194,12 +203,11 @@ def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng, repeats:
     path.write_text(STUDY.format(model=model.as_posix(), n=n, chunk=chunk, **MOUNT))
     study = load_study(path)
     run_study(study, None)  # warm-up
-    time_round, floor_of = eigenvalue_floor(study, rng.choice(study.size, size=min(1000, study.size), replace=False))
+    time_round, floor_of = eigenvalue_floor(study)
     seconds = np.inf
     for r in range(repeats):
         seconds = min(seconds, timed_study(study, tmp / f"coupled-{r}.zarr")[0])
-        for _ in range(2):
-            time_round()
+        time_round()
     subset = rng.choice(study.size, size=min(loop_sample, study.size), replace=False)
     t_loop = loop_time(study, subset)
     floor = floor_of()
