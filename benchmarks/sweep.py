@@ -20,10 +20,10 @@ Measured in one run on this machine:
   (the asymmetric example, classical linearization, over the first mount's x and shear
   stiffness), so that the figure for designs the block route cannot help is in the same line.
   Beside it the **compiled eigenvalue floor** (:func:`eigenvalue_floor`): the time of just the
-  eigenvalue problems these designs need, with the compiled small-matrix routines, timed in
-  rounds between the sweep's runs, each about as long as a run (so that both see the machine
-  in the same state, over the same span of time), and ``floor_ratio``, the sweep's time per
-  design over it.
+  eigenvalue problems these designs need, with the compiled small-matrix routines, timed in a
+  round right after each of the sweep's runs and about as long as one (so that both see the
+  machine in the same state, over the same span of time), and ``floor_ratio``, the median over
+  these pairs of the run's time per design over its round's.
 * **workers** -- the same study on a local Dask cluster (``impstab.studies.execute.local_cluster``)
   of each of ``--workers-list`` worker processes (default 1, 2, 4, 8; one thread each; the
   workers write their own chunks), cluster started and warmed up (one chunk on every worker)
@@ -140,9 +140,9 @@ def eigenvalue_floor(study):
     latter. Each is timed per problem on a stack of the designs' own operators at loads across
     their range, as many problems per design as the engine solves (rounded up), so that a round
     of the floor lasts about as long as the engine's part of a sweep. Returns ``time_round``,
-    which times one round (call it between the sweep's runs: both then see the machine in the same
-    state, over the same span of time), and ``floor``, which turns the fastest round into the
-    figures.
+    which times one round (call it right after a run of the sweep: both then see the machine in
+    the same state, over the same span of time) and returns its seconds per design, and ``floor``,
+    which turns the fastest round into the figures.
     """
     from impstab.linear.batch import critical_thrust_batch
     from impstab.linear.blocks import decoupled_blocks, eig_affine, eigvals_affine_blocks
@@ -169,18 +169,23 @@ def eigenvalue_floor(study):
     eig_affine(b0, b1, at, b_blocks)
     best = [np.inf, np.inf]
 
-    def time_round() -> None:
+    def per_design(t_vals: float, t_vecs: float) -> float:
+        return (values_only * t_vals + res.decompositions * t_vecs) / designs
+
+    def time_round() -> float:
         t0 = time.perf_counter()
         eigvals_affine_blocks(a0, a1, loads, blocks)
-        best[0] = min(best[0], (time.perf_counter() - t0) / loads.size)
+        t_vals = (time.perf_counter() - t0) / loads.size
         t0 = time.perf_counter()
         eig_affine(b0, b1, at, b_blocks)
-        best[1] = min(best[1], (time.perf_counter() - t0) / len(at))
+        t_vecs = (time.perf_counter() - t0) / len(at)
+        best[0], best[1] = min(best[0], t_vals), min(best[1], t_vecs)
+        return per_design(t_vals, t_vecs)
 
     def floor() -> dict:
         t_vals, t_vecs = best
-        per_design = (values_only * t_vals + res.decompositions * t_vecs) / designs
-        return {"floor_us_per_design": per_design * 1e6, "eigenvalue_us": t_vals * 1e6,
+        per_design_s = per_design(t_vals, t_vecs)
+        return {"floor_us_per_design": per_design_s * 1e6, "eigenvalue_us": t_vals * 1e6,
                 "decomposition_us": t_vecs * 1e6, "eigenvalue_problems_per_design": values_only / designs,
                 "decompositions_per_design": res.decompositions / designs, "designs": designs}
 
@@ -190,11 +195,13 @@ def eigenvalue_floor(study):
 def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng, repeats: int) -> dict:
     """Sweep and loop on the asymmetric example (classical linearization): no decoupled blocks.
 
-    The sweep's runs alternate with rounds of the eigenvalue floor of the same designs, each
-    round about as long as a run (the fastest of each counts), so that the ratio compares the two
-    on the machine in the same state: on a shared machine the speed changes by 1.5x within
-    minutes; a floor timed apart put the ratio anywhere from 1.2x to 2.3x, and one timed in
-    rounds of a few milliseconds caught quiet moments that no run of a second could.
+    Each run of the sweep is followed by a round of the eigenvalue floor of the same designs,
+    about as long as the run, and the pair gives one ratio: the two saw the machine in the same
+    state. ``floor_ratio`` is the median of the pairs' ratios (``floor_ratios``: each pair's);
+    the designs per second are the fastest run's (the timeit convention). On a shared machine the
+    speed changes by 1.5x within minutes: a floor timed apart put the ratio anywhere from 1.2x to
+    2.3x, the fastest run over the fastest round of a few milliseconds compared a run slowed by
+    the neighbours with a round that had caught a quiet moment.
     """
     text = COUPLED_EXAMPLE.read_text()
     model = tmp / "coupled.toml"
@@ -204,16 +211,16 @@ def coupled_rates(tmp: Path, n: int, chunk: int, loop_sample: int, rng, repeats:
     study = load_study(path)
     run_study(study, None)  # warm-up
     time_round, floor_of = eigenvalue_floor(study)
-    seconds = np.inf
+    runs, ratios = [], []
     for r in range(repeats):
-        seconds = min(seconds, timed_study(study, tmp / f"coupled-{r}.zarr")[0])
-        time_round()
+        runs.append(timed_study(study, tmp / f"coupled-{r}.zarr")[0])
+        ratios.append(runs[-1] / study.size / time_round())
+    seconds = min(runs)
     subset = rng.choice(study.size, size=min(loop_sample, study.size), replace=False)
     t_loop = loop_time(study, subset)
-    floor = floor_of()
     return {"designs_per_s": study.size / seconds, "speedup_vs_loop": t_loop * study.size / seconds,
-            "loop_us_per_design": t_loop * 1e6, "eigenvalue_floor": floor,
-            "floor_ratio": seconds / study.size / (floor["floor_us_per_design"] * 1e-6)}
+            "loop_us_per_design": t_loop * 1e6, "eigenvalue_floor": floor_of(),
+            "floor_ratio": float(np.median(ratios)), "floor_ratios": ratios}
 
 
 def timed_study(study, store: Path, **kw) -> tuple[float, object]:
@@ -374,8 +381,9 @@ def main() -> int:
             fl = coupled["eigenvalue_floor"]
             print(f"eigenvalue floor {fl['floor_us_per_design']:.1f} us/design: {fl['eigenvalue_problems_per_design']:.1f} "
                   f"eigenvalue problems x {fl['eigenvalue_us']:.2f} us + {fl['decompositions_per_design']:.1f} "
-                  f"decompositions x {fl['decomposition_us']:.2f} us (compiled); the coupled sweep takes "
-                  f"{coupled['floor_ratio']:.2f}x that")
+                  f"decompositions x {fl['decomposition_us']:.2f} us (compiled, fastest round); the coupled sweep "
+                  f"takes {coupled['floor_ratio']:.2f}x the floor (median of runs each over the round after it: "
+                  f"{', '.join(f'{r:.2f}' for r in coupled['floor_ratios'])})")
         workers, at_scale, parallel, e2e = {}, {}, None, {}
         if not args.no_workers:
             counts = sorted({int(w) for w in args.workers_list.split(",") if w.strip()})
