@@ -147,7 +147,12 @@ def cache_new(n):
             np.zeros(SLOTS, dtype=np.int64), np.zeros(1, dtype=np.int64))
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+def _finite_numpy(a):
+    """:func:`_finite` while kernels run interpreted: one NumPy test, not a Python loop."""
+    return bool(np.isfinite(a).all())
+
+
+@njit(cache=True, error_model="numpy", _nrt=False, interpreted=_finite_numpy)
 def _finite(a):
     for x in a.flat:
         if not np.isfinite(x):
@@ -169,7 +174,16 @@ def operators_at(jobs, j, loads, out):
     return _provided_operators(jobs.ints[j, KEY], loads, out)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+def _values_of_numpy(op, ws, out):
+    """:func:`_values_of` while kernels run interpreted: the same steps, without copying ``op``
+    element by element in Python (interpreted, :func:`_solve_one` is LAPACK's ``geev``, which
+    leaves its matrix as it is)."""
+    n = op.shape[0]
+    if n > MAX_ORDER or not _solve_one(op, n, ws[2], ws[3], ws[4], out):
+        _lapack_values(op, out)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False, interpreted=_values_of_numpy)
 def _values_of(op, ws, out):
     """Eigenvalues of the real matrix ``op`` into ``out``: compiled QR, else LAPACK."""
     n = op.shape[0]
