@@ -271,6 +271,11 @@ def _values2(a, b, c, d):
     return complex(m, w), complex(m, -w)
 
 
+#: ``first`` of :func:`_vector2`: NumPy booleans, compiled once (``True`` and ``False`` would each be
+#: a literal type of their own, compiled separately)
+_FIRST, _SECOND = np.bool_(True), np.bool_(False)
+
+
 @njit(cache=True, error_model="numpy")
 def _vector2(lam, a, b, c, d, first):
     """Unit eigenvector of ``[[a, b], [c, d]]`` for ``lam``: the larger of the two row solutions."""
@@ -413,8 +418,8 @@ def block_eig_at(a0, a1, s, p, order, starts, nblocks, mirror, vals, vecs, inv, 
             i, j = order[s, lo], order[s, lo + 1]
             a, bb, c, d = w0[0, 0], w0[0, 1], w0[1, 0], w0[1, 1]
             l1, l2 = _values2(a, bb, c, d)
-            v00, v10 = _vector2(l1, a, bb, c, d, True)
-            v01, v11 = _vector2(l2, a, bb, c, d, False)
+            v00, v10 = _vector2(l1, a, bb, c, d, _FIRST)
+            v01, v11 = _vector2(l2, a, bb, c, d, _SECOND)
             det = v00 * v11 - v01 * v10
             if det == 0.0 or not (np.isfinite(det.real) and np.isfinite(det.imag)):
                 good = False

@@ -41,7 +41,8 @@ from ..participation import participation_into
 from .layout import (AFFINE, BISECTIONS, BRACKETS, DECOMPOSITIONS, DIRECTION, EVALUATIONS, FIRST, FORM, HI, KEY, KIND, LO, LOAD,
                      OMEGA, START_UNSTABLE, STATUS, WARNED)
 from .scan import _classify
-from .spectra import FAILED, NOT_FINITE, OK, PROVIDER_ERROR, cache_new, provided_weights, spectrum, workspace
+from .spectra import (DECOMPOSITION, FAILED, NOT_FINITE, OK, PROVIDER_ERROR, VALUES, cache_new, provided_weights,
+                      spectrum, workspace)
 from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_COPIES, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
 
 __all__ = ["refine_stack"]
@@ -545,7 +546,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
             steps = 0 if start_unstable else 200
             for _ in range(steps):
                 point[0] = b
-                code_b, sb = spectrum(jobs, j, point, True, cache, ws, ev)
+                code_b, sb = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                 if code_b == PROVIDER_ERROR:
                     failed = True
                     break
@@ -556,7 +557,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         limit = True
                         break
                     point[0] = mid
-                    if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
+                    if spectrum(jobs, j, point, VALUES, cache, ws, ev)[0] == PROVIDER_ERROR:
                         failed = True
                         break
                     _classify(vals1, lost1, undamped, one_flag, one_ind, cplx, neg, scratch)
@@ -570,7 +571,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 if found and code_b == OK:
                     k = projector(c_vecs[sb], c_inv[sb], members, vc, wc)
                     point[0] = a
-                    code_a, sa = spectrum(jobs, j, point, True, cache, ws, ev)
+                    code_a, sa = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                     if code_a == PROVIDER_ERROR:
                         failed = True
                         break
@@ -585,7 +586,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                             marginal = True
                             for p in (a, min(max(a + (a - b), lo_lim), hi_lim)):
                                 point[0] = p
-                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
@@ -613,7 +614,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         clear = True
                         for e in range(2):
                             point[0] = a if e == 0 else b
-                            code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                            code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                             if code == PROVIDER_ERROR:
                                 failed = True
                                 break
@@ -639,7 +640,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                             p = hermite_root(a, b, fa, fb, dfab[0], dfab[1])
                             for _ in range(100):
                                 point[0] = last = p
-                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
@@ -663,7 +664,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                     root = x
                                     break
                                 point[0] = last = x
-                                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                                code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
@@ -678,16 +679,17 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         # the onset values: cluster at the root (or at the last point evaluated, where
                         # that is within 1e-12 of it), distinct modes at a (stable side)
                         point[0] = last if abs(root - last) <= 1e-12 * abs(root) else root
-                        code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                        code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
                         select(c_vecs[s], vc, wc, k, sel, share, work[0])
-                        cols[:k] = sel[:k]
+                        for i in range(k):  # loops, not slice assignments (see scan_stack)
+                            cols[i] = sel[i]
                         shapes, values = _take(c_vals[s], c_vecs[s], cols, k, n_dof)
                         vals_r, vecs_r = c_vals[s].copy(), c_vecs[s].copy()
                         point[0] = a
-                        code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                        code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
@@ -704,7 +706,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 if mid == a or mid == b:
                     break
                 point[0] = mid
-                if spectrum(jobs, j, point, False, cache, ws, ev)[0] == PROVIDER_ERROR:
+                if spectrum(jobs, j, point, VALUES, cache, ws, ev)[0] == PROVIDER_ERROR:
                     failed = True
                     break
                 _classify(vals1, lost1, undamped, one_flag, one_ind, cplx, neg, scratch)
@@ -726,7 +728,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 coalesce = False
                 root = b
                 point[0] = b
-                code, s = spectrum(jobs, j, point, True, cache, ws, ev)
+                code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                 if code == PROVIDER_ERROR:
                     failed = True
                     break
@@ -739,7 +741,8 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                 shapes, values = _take(c_vals[s], c_vecs[s], cols, k, n_dof)
                 vals_r, vecs_r = c_vals[s].copy(), c_vecs[s].copy()
             if affine or jobs.ints[j, KEY] < 0:
-                weights[:] = jobs.weights[j]
+                for i in range(len(weights)):
+                    weights[i] = jobs.weights[j, i]
             elif provided_weights(jobs.ints[j, KEY], root, weights) != 0:
                 failed = True
                 break
@@ -749,8 +752,10 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
             onsets[j, t, WARNED] = 1.0 if warned else 0.0
             if start_unstable or (a < b and (first < 0 or root < onsets[j, first, LOAD])):
                 first = t
-                mode_out[j, :] = mode
-                part_out[j, :] = part
+                for i in range(mode_out.shape[1]):
+                    mode_out[j, i] = mode[i]
+                for i in range(part_out.shape[1]):
+                    part_out[j, i] = part[i]
         counts[j, EVALUATIONS] += ev[0]
         counts[j, DECOMPOSITIONS] += ev[1]
         counts[j, FIRST] = first

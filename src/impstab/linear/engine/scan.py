@@ -24,10 +24,10 @@ from __future__ import annotations
 import numpy as np
 from ..._jit import njit, objmode
 
-from ..classify import _indicators, _masks
+from ..classify import _indicators, _insert, _masks
 from ..small_eigvec import _eigvector
 from .layout import BRACKETS, CHUNK, DECOMPOSITIONS, EVALUATIONS, FORM, HI, LO, N_SCAN, PAIRS, START_UNSTABLE, STATUS
-from .spectra import OK, PROVIDER_ERROR, cache_new, operators_at, spectrum, workspace
+from .spectra import DECOMPOSITION, OK, PROVIDER_ERROR, VALUES, cache_new, operators_at, spectrum, workspace
 from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
 
 __all__ = ["scan_stack"]
@@ -170,7 +170,9 @@ def closest_pair(vals, lower, upper):
         worst = max(worst, abs(v.imag))
     if worst > TOL_UNSTABLE * big:
         return -1
-    re = np.sort(vals.real)
+    re = np.empty(n)  # the real parts, sorted (an insertion sort: n is small, and numba's
+    for i in range(n):  # np.sort is a quicksort compiled for this one call)
+        _insert(re, i, vals[i].real)
     scale = 0.0
     for x in re:
         scale = max(scale, abs(x))
@@ -324,13 +326,15 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                     break  # a change, or unstable at jj: the next point is not needed
                 while known < need:  # classify the next chunk
                     stop = min(known + chunk, npts)
-                    code, _ = spectrum(jobs, j, grid[known:stop], False, cache, ws, counter)
+                    code, _ = spectrum(jobs, j, grid[known:stop], VALUES, cache, ws, counter)
                     if code == PROVIDER_ERROR:
                         failed = True
                         break
                     m = stop - known
                     _classify(ws[10][:m], ws[11][:m], undamped, flags[known:stop], ind[known:stop], cplx[:m], neg[:m], scratch)
-                    vals_grid[known:stop] = ws[10][:m]
+                    for i in range(m):  # loops, not slice assignments: numba compiles a
+                        for c in range(n):  # broadcast check (and its error message) for those
+                            vals_grid[known + i, c] = ws[10][i, c]
                     known = stop
                 if failed or flags[0]:
                     break
@@ -375,7 +379,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                                 counter[0] += 1
                                 counter[2] += 1
                             if pull < 0:  # repeated eigenvalues, or no inverse iteration: decompose
-                                code, s = spectrum(jobs, j, grid[jj:jj + 1], True, cache, ws, counter)
+                                code, s = spectrum(jobs, j, grid[jj:jj + 1], DECOMPOSITION, cache, ws, counter)
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
@@ -391,7 +395,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                     probe[0] = fmin_start(st, grid[jj - 1], grid[jj + 1], (grid[jj + 1] - grid[jj - 1]) * 1e-9)
                     more = True
                     while more:
-                        code, _ = spectrum(jobs, j, probe, False, cache, ws, counter)
+                        code, _ = spectrum(jobs, j, probe, VALUES, cache, ws, counter)
                         if code == PROVIDER_ERROR:
                             failed = True
                             break

@@ -197,15 +197,21 @@ def _values_of(op, ws, out):
     _lapack_values(op, out)
 
 
+#: the ``vectors`` argument of :func:`spectrum`. NumPy booleans, not ``False`` and ``True``: numba
+#: compiles a compiled callee once more for each literal constant it is passed (``Literal[bool]``),
+#: but once for a NumPy boolean of either value
+VALUES, DECOMPOSITION = np.bool_(False), np.bool_(True)
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     """Eigenvalues or a decomposition of problem ``j``; returns ``(status, slot)``.
 
-    ``vectors`` False: the eigenvalues at every load of ``loads`` into ``ws[10][:m]``, with
+    ``vectors`` :data:`VALUES` (False): the eigenvalues at every load of ``loads`` into ``ws[10][:m]``, with
     ``ws[11][i]`` set where the operator is not finite (its eigenvalues are then those of the
     identity, a stable placeholder); the status is 0, or :data:`PROVIDER_ERROR`.
 
-    ``vectors`` True: the decomposition at ``loads[0]`` (values, unit eigenvectors, their
+    ``vectors`` :data:`DECOMPOSITION` (True): the decomposition at ``loads[0]`` (values, unit eigenvectors, their
     inverse) in cache slot ``slot``, computed unless cached; the status (:data:`OK`,
     :data:`FAILED`, :data:`NOT_FINITE`, :data:`PROVIDER_ERROR`) is also ``cache[1][slot]``.
     ``ev[0]`` counts the eigenproblems solved, ``ev[1]`` the decompositions among them.
