@@ -9,13 +9,14 @@ it for minutes.
 
 Two phases, each spread over ``--jobs`` processes (default the cores available, at most 4).
 Every command computes a critical thrust first, so every case needs the kernels of the stability
-engine and of the tangent stiffness at the static equilibrium: two independent sets, about two
-thirds and one third of the shared compile work. The first phase compiles them side by side
-through public entry points (:func:`warm_ups`: ``critical_load`` on a generic family; then
-``linearize`` and ``simulate`` of a model), so that no case starts before they are in the cache
-(two processes each compiling the engine would do the same minute of work twice). The second
-phase runs each command's cases in a process of their own, the heaviest first; they load the
-shared kernels and compile only their own.
+engine, and most need the tangent stiffness at the static equilibrium and a time integration.
+The first phase compiles these independent sets side by side through public entry points
+(:func:`warm_ups`: ``critical_load`` on a generic family; ``linearize`` and ``simulate``, without
+its critical thrust, of a model; the nonlinear right-hand side at complex states, for the
+post-critical analysis), so that no case starts before they are in the cache (two processes
+each compiling the engine would do the same minute of work twice). The second phase runs each
+command's cases in a process of their own, the heaviest first; they load the shared kernels
+and compile only their own.
 
 The cases use the bundled ``examples/`` when run from a source tree, else two small models
 and a small study written here. A command that uses kernels gets a line in :func:`cases`;
@@ -178,23 +179,44 @@ def _engine_family() -> None:
 
 
 def _tangent_and_time_integration(model: str, symmetric: str) -> None:
-    """The tangent stiffness at the static equilibrium (Newton statics of ``model``), then a short
-    time history of ``symmetric`` (the right-hand side and the Hamming integrator)."""
+    """The tangent stiffness at the static equilibrium (Newton statics of ``model``), then short
+    time histories of ``symmetric`` with the fixed-step integrator and the two SciPy ones that
+    have kernels of their own (the right-hand side, its Jacobian, the dense output). No critical
+    thrust: that is the engine's warm-up."""
     from .dynamics import simulate
     from .linear.linearize import linearize
     from .model import load_model
 
     linearize(load_model(model), thrust=1000.0)
-    simulate(load_model(symmetric), thrust=1000.0, duration=0.05)
+    sym = load_model(symmetric)
+    for integrator in ("hamming", "radau", "dop853"):
+        simulate(sym, thrust=1000.0, duration=0.05, integrator=integrator, critical_thrust=False)
+
+
+def _nonlinear_right_hand_side(model: str) -> None:
+    """The right-hand side of ``model`` (nonlinear mount laws) at real and complex states, as the
+    post-critical analysis evaluates it (complex-step derivatives)."""
+    import numpy as np
+
+    from .dynamics.system import NonlinearSystem
+    from .model import load_model
+
+    ns = NonlinearSystem(load_model(model))
+    ns.rhs(np.zeros(ns.n_states), 1000.0)
+    ns.rhs(np.zeros(ns.n_states, dtype=complex), 1000.0)
 
 
 def warm_ups(models: dict[str, Path]) -> list[tuple[str, object, tuple]]:
-    """``(label, function, arguments)`` of the first phase: independent kernel sets that every
-    command shares, compiled side by side before any case runs."""
+    """``(label, function, arguments)`` of the first phase, the heaviest first: independent kernel
+    sets that the cases share, compiled side by side (each to the first process free) before any
+    case runs."""
     sym = str(models["symmetric"])
-    return [("stability engine", _engine_family, ()),
-            ("tangent stiffness, time integration", _tangent_and_time_integration,
-             (str(models.get("asymmetric", models["symmetric"])), sym))]
+    out = [("stability engine", _engine_family, ()),
+           ("tangent stiffness, time integration", _tangent_and_time_integration,
+            (str(models.get("asymmetric", models["symmetric"])), sym))]
+    if "hardening" in models:
+        out.append(("nonlinear right-hand side", _nonlinear_right_hand_side, (str(models["hardening"]),)))
+    return out
 
 
 def _warm(label: str, func, args: tuple, quiet: bool) -> list[tuple[str, str]]:
