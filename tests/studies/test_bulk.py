@@ -192,3 +192,36 @@ def test_a_stack_and_separate_designs_in_one_batch():
     np.testing.assert_array_equal(got.status, 0)
     np.testing.assert_array_equal(got.thrust, ref.thrust)
     np.testing.assert_array_equal(got.kind, ref.kind)
+
+
+def _with_eigenvalues(rng, values):
+    q, _ = np.linalg.qr(rng.standard_normal((6, 6)))
+    return (q * np.asarray(values, dtype=float)) @ q.T
+
+
+@pytest.mark.parametrize("case", ["well restrained", "one free motion", "near the margin", "within tr K of it",
+                                  "indefinite", "negative trace", "huge numbers"])
+def test_restraint_check_is_the_eigenvalue_rule(case):
+    # the batched Cholesky shortcut says "all restrained" only where the rule (lambda_min >
+    # margin lambda_max) holds for every design, else the rule itself decides
+    from impstab.studies.bulk import _RESTRAINT_MARGIN, _restrained
+
+    rng = np.random.default_rng(7)
+    stack = [_with_eigenvalues(rng, rng.uniform(1e3, 1e6, 6)) for _ in range(40)]
+    odd = {"well restrained": None,
+           "one free motion": [0.0, 1e4, 2e4, 3e4, 4e4, 5e4],
+           "near the margin": [0.5e-8, 1, 1, 1, 1, 1],         # below the margin: not restrained
+           "within tr K of it": [2e-8, 1, 1, 1, 1, 1],        # restrained, but lambda_min < margin tr K
+           "indefinite": [-1.0, 1e4, 1e4, 1e4, 1e4, 1e4],
+           "negative trace": [-1e4, -1e4, -1e4, 1e-3, 1e-3, 1e-3]}.get(case)
+    if odd is not None:
+        stack[17] = _with_eigenvalues(rng, odd)
+    k = np.array(stack)
+    if case == "huge numbers":  # entries near the largest float (stiffness files are capped far below)
+        k[5] *= 1e300
+    got = _restrained(k)
+    with np.errstate(over="ignore", invalid="ignore"):
+        ev = np.linalg.eigvalsh(k)
+    rule = ev[:, 0] > _RESTRAINT_MARGIN * ev[:, -1]
+    np.testing.assert_array_equal(got, rule)
+    assert got.all() == (case in ("well restrained", "within tr K of it", "huge numbers"))

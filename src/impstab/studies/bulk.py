@@ -107,6 +107,27 @@ def _invalid(path, column: NDArray) -> NDArray[np.bool_]:
     return bad[inverse.ravel()]
 
 
+def _restrained(k: NDArray) -> NDArray[np.bool_]:
+    """Whether each symmetric ``k (n, 6, 6)`` has ``lambda_min > _RESTRAINT_MARGIN lambda_max``.
+
+    First one batched Cholesky factorisation of ``K - s I`` with ``s = margin tr K``: where every
+    design has ``s > 0`` and the factorisation succeeds, each ``K`` is positive definite with
+    ``lambda_min > s``, so ``tr K >= lambda_max`` and the rule holds for the whole chunk (0.7 us a
+    design against 3.7 us for the eigenvalues). Otherwise -- some design fails or comes near, or
+    the numbers overflow -- the rule itself on the eigenvalues. Both read the lower triangle.
+    """
+    shift = _RESTRAINT_MARGIN * np.trace(k, axis1=-2, axis2=-1)
+    if np.all(np.isfinite(shift) & (shift > 0.0)):
+        try:
+            factor = np.linalg.cholesky(k - shift[:, None, None] * np.eye(k.shape[-1]))
+        except np.linalg.LinAlgError:
+            factor = None
+        if factor is not None and np.isfinite(factor).all():
+            return np.ones(len(k), dtype=bool)
+    ev = np.linalg.eigvalsh(k)
+    return ev[:, 0] > _RESTRAINT_MARGIN * ev[:, -1]
+
+
 def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArray], name: str = "model") -> BulkDesigns | None:
     """Matrices of every design of a chunk, or None when the study is not eligible.
 
@@ -170,8 +191,7 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
     length_scale = np.maximum(arms.max(axis=1), 1e-3)
     # the model rule "the mounts restrain all six motions", on the condensed stiffness
     with np.errstate(invalid="ignore", over="ignore"):
-        ev = np.linalg.eigvalsh(np.nan_to_num(condense(positions, stiffness)))
-    bad |= ~(ev[:, 0] > _RESTRAINT_MARGIN * ev[:, -1])
+        bad |= ~_restrained(np.nan_to_num(condense(positions, stiffness)))
     good = np.flatnonzero(~bad)
     if len(good) < n:
         positions, stiffness, length_scale = positions[good], stiffness[good], length_scale[good]
