@@ -141,7 +141,8 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
     }
     iso_names = tuple(n for n in task.outputs if n in ISOLATION_OUTPUTS
                       or (task.isolation is not None and any(p.name == n for p in task.isolation.at)))
-    if iso_names or any(name in POSTCRITICAL_OUTPUTS for name in task.outputs):
+    postcritical = any(name in POSTCRITICAL_OUTPUTS for name in task.outputs)
+    if iso_names or postcritical:
         # the designs assembled in bulk as models too: these outputs need the model's view
         models = [_variant(task, j) if in_bulk[j] else m for j, m in enumerate(models)]
     if iso_names:
@@ -152,7 +153,7 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
                 status[j] = STATUSES.index("numerical_failure")
                 message[j] = text
         failed = status != 0
-    if any(name in POSTCRITICAL_OUTPUTS for name in task.outputs):
+    if postcritical:
         values.update(_postcritical(models, res, failed, message, "fold_thrust" in task.outputs))
     data: dict[str, NDArray] = {}
     for name in task.outputs:
