@@ -146,6 +146,7 @@ def eigenvalue_floor(study):
     """
     from impstab.linear.batch import critical_thrust_batch
     from impstab.linear.blocks import decoupled_blocks, eig_affine, eigvals_affine_blocks
+    from impstab.linear.engine.problems import mass_solve
     from impstab.studies.bulk import assemble_bulk
 
     segs = [p.path.segments for p in study.parameters]
@@ -155,7 +156,8 @@ def eigenvalue_floor(study):
     res = critical_thrust_batch([None] * study.size, affine=stack)  # the designs not in bulk: skipped
     designs = len(stack)
     values_only = res.evaluations - res.decompositions
-    a0, a1 = np.linalg.solve(stack.mass, stack.k0), np.linalg.solve(stack.mass, stack.k1)
+    # the engine's own operators M^-1 K0, M^-1 K1 (mass_solve, as the batch forms them)
+    a0, a1 = np.moveaxis(mass_solve(stack.mass, np.stack([stack.k0, stack.k1], axis=1)), 1, 0)
     t_max = stack.thrust_max
     blocks = decoupled_blocks(a0, a1, t_max)
     n_vals = max(1, int(np.ceil(values_only / designs)))
