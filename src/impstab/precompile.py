@@ -9,12 +9,12 @@ it for minutes.
 
 Two phases, each spread over ``--jobs`` processes (default the cores available, at most 4).
 Every command computes a critical thrust first, so every case needs the kernels of the stability
-engine, and most need the tangent stiffness at the static equilibrium and a time integration.
-The first phase compiles these independent sets side by side through public entry points
-(:func:`warm_ups`: ``critical_load`` on a generic family; ``linearize`` and ``simulate``, without
-its critical thrust, of a model; the nonlinear right-hand side at complex states, for the
-post-critical analysis), so that no case starts before they are in the cache (two processes
-each compiling the engine would do the same minute of work twice). The second phase runs each
+engine, and most need the tangent stiffness at the static equilibrium, the right-hand side and
+a time integration. The first phase compiles these independent sets side by side through public
+entry points (:func:`warm_ups`: ``critical_load`` on a generic family; ``linearize`` of a model;
+the nonlinear right-hand side at real and complex states; the fixed-step integrator on a linear
+oscillator), so that no case starts before they are in the cache (two processes each compiling
+the engine would do the same minute of work twice), and no two of them compile the same kernel. The second phase runs each
 command's cases in a process of their own, the heaviest first; they load the shared kernels
 and compile only their own.
 
@@ -178,24 +178,19 @@ def _engine_family() -> None:
     critical_load(m, k0, k1, D=np.diag([40.0, 8.0, 8.0, 1.0, 1.0, 1.0]), p_max=1.0e5)
 
 
-def _tangent_and_time_integration(model: str, symmetric: str) -> None:
-    """The tangent stiffness at the static equilibrium (Newton statics of ``model``), then short
-    time histories of ``symmetric`` with the fixed-step integrator and the two SciPy ones that
-    have kernels of their own (the right-hand side, its Jacobian, the dense output). No critical
-    thrust: that is the engine's warm-up."""
-    from .dynamics import simulate
+def _tangent_stiffness(model: str) -> None:
+    """The tangent stiffness at the static equilibrium (Newton statics of ``model``, then the
+    classical and equilibrium forms)."""
     from .linear.linearize import linearize
     from .model import load_model
 
     linearize(load_model(model), thrust=1000.0)
-    sym = load_model(symmetric)
-    for integrator in ("hamming", "radau", "dop853"):
-        simulate(sym, thrust=1000.0, duration=0.05, integrator=integrator, critical_thrust=False)
 
 
-def _nonlinear_right_hand_side(model: str) -> None:
-    """The right-hand side of ``model`` (nonlinear mount laws) at real and complex states, as the
-    post-critical analysis evaluates it (complex-step derivatives)."""
+def _right_hand_side(model: str) -> None:
+    """The nonlinear right-hand side of ``model`` at real states (the SciPy integrators' ``fun``)
+    and at complex ones (their Jacobian, and the post-critical analysis: complex-step
+    derivatives)."""
     import numpy as np
 
     from .dynamics.system import NonlinearSystem
@@ -206,17 +201,25 @@ def _nonlinear_right_hand_side(model: str) -> None:
     ns.rhs(np.zeros(ns.n_states, dtype=complex), 1000.0)
 
 
+def _fixed_step_integrator() -> None:
+    """The fixed-step integrators' compiled step loop (Gill's start, Hamming's method), on a
+    linear oscillator: a model's time history calls it with the same argument types."""
+    import numpy as np
+
+    from .dynamics.integrators import integrate_linear
+
+    integrate_linear(np.array([[0.0, 1.0], [-1.0, 0.0]]), np.array([1.0, 0.0]), 0.01, 8)
+
+
 def warm_ups(models: dict[str, Path]) -> list[tuple[str, object, tuple]]:
     """``(label, function, arguments)`` of the first phase, the heaviest first: independent kernel
     sets that the cases share, compiled side by side (each to the first process free) before any
-    case runs."""
+    case runs; no two of them compile the same kernel."""
     sym = str(models["symmetric"])
-    out = [("stability engine", _engine_family, ()),
-           ("tangent stiffness, time integration", _tangent_and_time_integration,
-            (str(models.get("asymmetric", models["symmetric"])), sym))]
-    if "hardening" in models:
-        out.append(("nonlinear right-hand side", _nonlinear_right_hand_side, (str(models["hardening"]),)))
-    return out
+    return [("stability engine", _engine_family, ()),
+            ("tangent stiffness", _tangent_stiffness, (str(models.get("asymmetric", sym)),)),
+            ("right-hand side, real and complex", _right_hand_side, (str(models.get("hardening", sym)),)),
+            ("fixed-step integrator", _fixed_step_integrator, ())]
 
 
 def _warm(label: str, func, args: tuple, quiet: bool) -> list[tuple[str, str]]:

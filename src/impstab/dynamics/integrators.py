@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from ..errors import ModelError
 from .kernels import CARRY_ROWS, METHOD_GILL, METHOD_HAMMING, run_fixed
-from .rhs import AMPLITUDE, DOUBLE, HALVE, NONFINITE, OK, PITCH, rhs_batch, rhs_into
+from .rhs import AMPLITUDE, DOUBLE, HALVE, NONFINITE, OK, PITCH, rhs_batch
 from .system import COMPLEX_STEP, DynamicSystem, linear_dynamics
 
 __all__ = ["Problem", "RawRun", "Integrator", "INTEGRATORS", "register", "get_integrator", "integrate_linear"]
@@ -240,11 +240,13 @@ class _SolveIvp(Integrator):
                 return float(ld[0, 0]), float(ld[1, 0])
             return const
 
+        one = np.zeros(1, dtype=np.int64)
+
         def fun(t, z):
             thrust, spin = loads_at(t)
-            out = np.empty(n)
-            rhs_into(kind, arrays, yeq, np.ascontiguousarray(z, dtype=float), thrust, spin, out)
-            return out
+            out = np.empty((1, n))  # a new array each call: solve_ivp keeps the ones it is given
+            rhs_batch(kind, arrays, yeq, np.ascontiguousarray(z, dtype=float).reshape(1, n), thrust, spin, out, one)
+            return out[0]
 
         jac = None
         if self.implicit:

@@ -84,7 +84,7 @@ from ..kinematics.scalar import cos, sin
 from ..kinematics.so3 import _jinv_into, _log_so3_into
 from ..model.mount_law import law_gradient
 
-__all__ = ["rhs_into", "rhs_batch", "model_rhs", "beam_body", "mount_loads_series", "workspace", "PITCH_LIMIT",
+__all__ = ["rhs_batch", "model_rhs", "beam_body", "mount_loads_series", "workspace", "PITCH_LIMIT",
            "KIND_MODEL", "KIND_LINEAR", "FLAG_ROTATION", "FLAG_LAW", "N_BODY"]
 
 #: default guard on the pitch angle (rad): the z-y-x Euler angles are singular at +-90 degrees
@@ -478,24 +478,14 @@ def linear_rhs(amat, z, out):
 
 
 @njit(cache=True, error_model="numpy", compile_first=True)
-def rhs_into(kind, arrays, yeq, z, thrust, spin, out):
-    """``out = z'`` at deviation ``z`` with thrust ``thrust`` (N) and spin ``spin`` (rad/s).
-
-    ``arrays`` is the tuple of :class:`~impstab.dynamics.system.DynamicSystem`. Allocates its
-    workspace per call: loops use :func:`model_rhs` with a workspace of their own.
-    """
-    if kind == KIND_LINEAR:
-        return linear_rhs(arrays[8], z, out)
-    rot, jinv, ws = workspace(z)
-    return model_rhs(arrays[0], arrays[1], arrays[2], arrays[3], arrays[4], arrays[9], arrays[10], arrays[5],
-                     arrays[6], arrays[7], arrays[11], arrays[12], arrays[13], arrays[14], arrays[15], yeq, z, thrust,
-                     spin, out, rot, jinv, ws)
-
-
-@njit(cache=True, error_model="numpy", compile_first=True)
 def rhs_batch(kind, arrays, yeq, zs, thrust, spin, out, status):
-    """``out[k] = z'`` at each row ``zs[k]`` (real or complex), one workspace for all rows;
-    ``status[k]`` the row's status."""
+    """``out[k] = z'`` at each row ``zs[k]`` (real or complex) with thrust ``thrust`` (N) and spin
+    ``spin`` (rad/s), one workspace for all rows; ``status[k]`` the row's status.
+
+    ``arrays`` is the tuple of :class:`~impstab.dynamics.system.DynamicSystem`. The one entry
+    point from Python (a single state is a batch of one row); compiled loops call
+    :func:`model_rhs` with a workspace of their own.
+    """
     if zs.shape[0] == 0:
         return
     rot, jinv, ws = workspace(zs[0])

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from ..model.mount_law import N_LAW
 from .rhs import (FLAG_LAW, FLAG_ROTATION, KIND_LINEAR, KIND_MODEL, N_BODY, N_PAR, P_CG, P_E, P_IA, P_JP, P_MASS, P_PITCH,
-                  P_RADIATION, P_ROTATION, P_RT, P_TANG, PITCH_LIMIT, mount_loads_series, rhs_batch, rhs_into)
+                  P_RADIATION, P_ROTATION, P_RT, P_TANG, PITCH_LIMIT, mount_loads_series, rhs_batch)
 
 __all__ = ["DynamicSystem", "NonlinearSystem", "pack_dynamics", "linear_dynamics", "evaluate_rhs", "mount_loads",
            "equilibrium_state", "STATE_NAMES", "COMPLEX_STEP"]
@@ -140,10 +140,11 @@ def linear_dynamics(amat) -> DynamicSystem:
 
 def evaluate_rhs(system: DynamicSystem, yeq, z, thrust: float, spin: float = 0.0):
     """Python entry to the right-hand side: returns ``(z', status)``."""
-    out = np.empty(system.n_states)
-    status = rhs_into(system.kind, system.arrays, np.ascontiguousarray(yeq, dtype=float),
-                      np.ascontiguousarray(z, dtype=float), float(thrust), float(spin), out)
-    return out, int(status)
+    out = np.empty((1, system.n_states))
+    status = np.zeros(1, dtype=np.int64)
+    rhs_batch(system.kind, system.arrays, np.ascontiguousarray(yeq, dtype=float),
+              np.ascontiguousarray(z, dtype=float).reshape(1, -1), float(thrust), float(spin), out, status)
+    return out[0], int(status[0])
 
 
 def equilibrium_state(model, thrust: float):
