@@ -207,6 +207,23 @@ def test_chunked_run_equals_one_run(ramp_problem):
     np.testing.assert_array_equal(out[:401], whole)
 
 
+@pytest.mark.parametrize("integrator", ["hamming", "gill"])
+def test_a_constant_thrust_as_one_column_equals_its_value_at_every_half_step(integrator):
+    """A constant thrust reaches the step loop as one (thrust, spin) column; the same thrust as a
+    function of time reaches it as its value at every half step. The two runs are the same run."""
+    import impstab
+
+    model = model_from_dict(asymmetric(damped=True, gyro=True, tangency=0.8))
+    pert = {"velocity": [0.01, 0.02, 0.03, 0.1, 0.2, 0.3]}
+    kw = dict(duration=0.5, integrator=integrator, perturbation=pert, critical_thrust=False)
+    one = impstab.simulate(model, thrust=7000.0, **kw)
+    every = impstab.simulate(model, thrust=lambda t: 7000.0 + 0.0 * np.asarray(t), **kw)
+    assert "user function" in every.thrust_history and "user function" not in one.thrust_history
+    assert one.steps == every.steps > 100
+    np.testing.assert_array_equal(one.deviation, every.deviation)
+    assert np.abs(one.deviation).max() > 1e-4
+
+
 SCRIPT = """
 import sys, numpy as np
 sys.path.insert(0, {here!r})

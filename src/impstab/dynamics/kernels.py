@@ -73,7 +73,8 @@ def run_fixed(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist
     Parameters
     ----------
     method : 0 (Gill) or 1 (Hamming)
-    loads : (2, 2 n_steps + 1) thrust (N) and propeller spin (rad/s) at ``t0 + j h / 2``
+    loads : (2, 2 n_steps + 1) thrust (N) and propeller spin (rad/s) at ``t0 + j h / 2``, or
+        (2, 1) when they are constant
     carry : (8, n) history, updated in place; ``nhist`` levels of it are valid (0: only ``y_n``)
     out_z, out_err : sample arrays; samples are written at rows ``k0 + 1, k0 + 2, ...`` every
         ``stride`` steps (the caller wrote row ``k0``)
@@ -115,6 +116,7 @@ def _advance(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist,
     par, minv, damp6, amat = arrays[5], arrays[6], arrays[7], arrays[8]
     vstart, vpar = arrays[9], arrays[10]
     bpos, bmat, bstart, bmode, mass6 = arrays[11], arrays[12], arrays[13], arrays[14], arrays[15]
+    constant = loads.shape[1] == 1
     written = 0
     errmax = -1.0
     quiet = 0
@@ -199,6 +201,8 @@ def _advance(method, kind, arrays, yeq, h, n_steps, stride, loads, carry, nhist,
             if kind == KIND_LINEAR:
                 st = linear_rhs(amat, tmp, dest)
             else:
+                if constant:
+                    jl = 0
                 st = model_rhs(pos, kmat, cmat, flags, laws, vstart, vpar, par, minv, damp6, bpos, bmat, bstart,
                                bmode, mass6, yeq, tmp, loads[0, jl], loads[1, jl], dest, rot, jinv, ws)
             if stage == -1:
