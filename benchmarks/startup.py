@@ -4,8 +4,10 @@ Baseline: ``python -c "import numpy, scipy.linalg, pydantic"``, what any tool of
 before it computes anything (the goal: a warm ``critical --json`` within 2x of it), run with the
 BLAS thread count impstab's command line sets (:mod:`impstab._blas`).
 
-impstab, each in a fresh process (median of ``--repeat`` runs; wall time and the child's CPU time,
-user + sys, which a loaded machine disturbs less):
+impstab, each in a fresh process (``--repeat`` rounds, each running the baseline and every command
+once in turn; medians, and ratios as the median over the rounds of the command over the baseline
+of the same round; wall time and the child's CPU time, user + sys, which a loaded machine
+disturbs less):
 
 * ``impstab --version``, ``impstab --help``;
   (``python -m impstab.precompile`` runs first: kernels in the cache and impstab's bytecode written,
@@ -74,9 +76,22 @@ OTHER_EXAMPLES = ["imp_asymmetric", "imp_damped", "imp_fluid", "imp_viscoelastic
                   "imp_hardening"]
 
 
-def median_run(argv: list[str], repeat: int, env: dict | None = None) -> tuple[float, float]:
-    runs = [run(argv, env)[:2] for _ in range(repeat)]
-    return statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs)
+def rounds(rows: dict[str, tuple], repeat: int) -> dict[str, list[tuple[float, float]]]:
+    """``repeat`` rounds, each running every row once in turn (``(label, argv, [env])``): its
+    ``(wall s, CPU s)`` per round. Rows measured in the same round see the machine at the same
+    speed; on a shared machine that drifts by tens of percent within a minute, a row measured
+    in a block of its own would carry the drift into its ratio to the baseline."""
+    out: dict[str, list[tuple[float, float]]] = {key: [] for key in rows}
+    for _ in range(repeat):
+        for key, (_, argv, *env) in rows.items():
+            out[key].append(run(argv, *env)[:2])
+    return out
+
+
+def paired_ratio(runs: dict[str, list[tuple[float, float]]], key: str, which: int) -> float:
+    """The median over the rounds of ``key``'s time over the baseline's in the same round
+    (``which``: 0 wall, 1 CPU)."""
+    return statistics.median(r[which] / b[which] for r, b in zip(runs[key], runs["baseline"]))
 
 
 def importtime_breakdown(argv: list[str], repeat: int) -> dict[str, float]:
@@ -163,7 +178,8 @@ def main() -> int:
     critical = [*impstab, "critical", str(EXAMPLE), "--json"]
     run(critical)  # warm the file system cache
 
-    print(f"warm start-up, median of {args.repeat} fresh processes (shared machine: see the cpu column too)")
+    print(f"warm start-up, median of {args.repeat} rounds of fresh processes, every command once a round "
+          "(shared machine: see the cpu column too)")
     rows = {
         "baseline": ("python -c 'import numpy, scipy.linalg, pydantic'", BASELINE, SINGLE_THREAD),
         "python": ("python -c pass", [sys.executable, "-c", "pass"]),
@@ -175,16 +191,18 @@ def main() -> int:
     for name in OTHER_EXAMPLES:
         rows[name] = (f"impstab critical {name}.toml --json",
                       [*impstab, "critical", str(ROOT / "examples" / f"{name}.toml"), "--json"])
+    runs = rounds(rows, args.repeat)
     times = {}
-    for key, (label, argv, *env) in rows.items():
-        times[key] = median_run(argv, args.repeat, *env)
-        print(f"  {label:46s} {times[key][0]:6.3f} s  (cpu {times[key][1]:6.3f} s)", flush=True)
+    for key, (label, *_) in rows.items():
+        times[key] = (statistics.median(r[0] for r in runs[key]), statistics.median(r[1] for r in runs[key]))
+        print(f"  {label:46s} {times[key][0]:6.3f} s  (cpu {times[key][1]:6.3f} s)")
     base_wall, base_cpu = times["baseline"]
-    ratios = {k: (times[k][0] / base_wall, times[k][1] / base_cpu) for k in ("version", "help", "critical",
-                                                                             "critical_compiled")}
+    print("  ratios: the median over the rounds of the command's time over the baseline's in the same round")
+    ratios = {k: (paired_ratio(runs, k, 0), paired_ratio(runs, k, 1)) for k in ("version", "help", "critical",
+                                                                                "critical_compiled")}
     for k, (rw, rc) in ratios.items():
         print(f"  ratio {k:17s} / baseline: {rw:5.2f} (cpu {rc:5.2f})")
-    examples = {name: times[name][1] / base_cpu for name in OTHER_EXAMPLES}
+    examples = {name: paired_ratio(runs, name, 1) for name in OTHER_EXAMPLES}
     print("  cpu ratio of a warm critical --json / baseline: "
           + ", ".join(f"{name} {r:.2f}" for name, r in examples.items()))
 
