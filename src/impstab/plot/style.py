@@ -28,7 +28,10 @@ STYLE = {
     "axes.spines.right": False,
     "axes.formatter.useoffset": False,      # no offset labels that collide with titles
     "axes.formatter.limits": (-5, 7),       # plain numbers from 1e-5 to 1e7: no "x 10^5" label
-    "axes.formatter.use_mathtext": True,
+    # plain-text tick labels: with the two settings above no offset or multiplier label is left
+    # that mathtext would typeset, and typesetting every tick number through it cost 5-8 ms a
+    # distinct label (1.6 s of a 10.6 s report); log axes keep their mathtext powers of ten
+    "axes.formatter.use_mathtext": False,
     "lines.linewidth": 1.4,
     "image.cmap": "viridis",
     "svg.fonttype": "none",                 # text stays text in SVG (small, searchable)
