@@ -1,5 +1,6 @@
-"""Large undamped second-order problems: modal reduction with error checks, then the exact onset of
-the full model by shift-invert (a finite-element model with hundreds of dofs).
+"""Large second-order problems: modal reduction with error checks, then the exact onset of the full
+model by shift-invert (undamped) or Newton's method (damped) (a finite-element model with hundreds
+of dofs).
 
 For ``M q'' + (K0 + p K1) q = 0`` with symmetric ``M`` (positive definite) and ``K0`` of order
 ``n`` above :data:`LARGE_ORDER`:
@@ -23,6 +24,11 @@ For ``M q'' + (K0 + p K1) q = 0`` with symmetric ``M`` (positive definite) and `
    (``p_c (1 - 1e-6)``, one dense eigenvalue problem) must be stable by the engine's rule, and the
    cluster just above it complex (flutter) or through zero (divergence). If any check fails the
    problem goes to the dense route, with a warning saying why.
+
+A damped problem ``M q'' + (D + G) q' + (K0 + p K1) q = 0`` (``D + G`` constant) of first-order
+order above :data:`LARGE_ORDER` takes steps 1 and 2 with the first-order form of the reduced
+system (``Phi^T (D + G) Phi`` as its damping), then :func:`damped_full_onset`: Newton's method on
+``T(p, omega) x = 0`` of the full model from the reduced onset, and the same check below it.
 """
 
 from __future__ import annotations
@@ -37,7 +43,7 @@ from ...errors import NumericalError
 from .tolerances import FLOOR, TOL_CLUSTER, TOL_DUPLICATE, TOL_UNSTABLE
 
 __all__ = ["LARGE_ORDER", "BASIS", "TRUNCATION_TOLERANCE", "reducible", "modal_basis", "reduced_problem", "full_onset",
-           "stable_at"]
+           "damped_full_onset", "stable_at"]
 
 Array = NDArray[np.float64]
 
@@ -56,8 +62,11 @@ SHIFT_NUDGE = 1e-6
 
 
 def reducible(problem) -> bool:
-    """An affine undamped second-order problem of large order with symmetric M and K0."""
-    if not (problem.undamped and problem.affine and problem.second_order is not None and problem.order > LARGE_ORDER):
+    """An affine second-order problem of large order with symmetric M and K0 (undamped, or damped
+    with its ``D + G`` given)."""
+    if not (problem.affine and problem.second_order is not None and problem.order > LARGE_ORDER):
+        return False
+    if not (problem.undamped or problem.damping is not None):
         return False
     m, k0 = problem.second_order[0], problem.second_order[1]
     scale_m, scale_k = np.abs(m).max(), np.abs(k0).max()
@@ -88,13 +97,20 @@ def modal_basis(problem, m: int) -> tuple[Array, Array]:
 
 
 def reduced_problem(problem, w: Array, phi: Array):
-    """The undamped problem ``Omega^2 + p Phi^T K1 Phi`` of the modal basis (``M_r = I``)."""
+    """The problem of the modal basis (``M_r = I``): undamped, ``Omega^2 + p Phi^T K1 Phi``; damped,
+    the first-order form of ``q'' + Phi^T (D + G) Phi q' + (Omega^2 + p Phi^T K1 Phi) q = 0``."""
+    from ..eigen import state_matrices
     from .problems import Problem
 
     _, _, k1 = problem.second_order
-    a1 = np.ascontiguousarray(phi.T @ k1 @ phi)
+    k1_r = np.ascontiguousarray(phi.T @ k1 @ phi)
     m = len(w)
-    return Problem(True, problem.p_min, problem.p_max, problem.n_scan, m, m, np.diag(w).copy(), a1, np.ones(m))
+    if problem.undamped:
+        return Problem(True, problem.p_min, problem.p_max, problem.n_scan, m, m, np.diag(w).copy(), k1_r, np.ones(m))
+    a0 = state_matrices(np.eye(m), phi.T @ problem.damping @ phi, np.diag(w))
+    a1 = np.zeros_like(a0)
+    a1[m:, :m] = -k1_r
+    return Problem(False, problem.p_min, problem.p_max, problem.n_scan, 2 * m, m, a0, a1, np.ones(m))
 
 
 class _Pencil:
@@ -171,7 +187,18 @@ class _Pencil:
 
 def stable_at(problem, p: float) -> bool:
     """Whether the full model is stable at ``p`` (every eigenvalue, dense)."""
-    return _Pencil(problem).stable_everywhere(p)
+    if problem.undamped:
+        return _Pencil(problem).stable_everywhere(p)
+    return _first_order_stable(problem, p)
+
+
+def _first_order_stable(problem, p: float) -> bool:
+    """Whether every eigenvalue of the full first-order operator ``a0 + p a1`` is stable by the
+    engine's rule (one dense eigenvalue problem)."""
+    a0, a1 = problem.operators()
+    vals = np.linalg.eigvals(a0 + p * a1)
+    unstable, _ = classify_eigenvalues(vals[None], False, TOL_UNSTABLE, TOL_CLUSTER, FLOOR, TOL_DUPLICATE)
+    return not bool(unstable[0])
 
 
 def _indicator(c: Array, b: Array, divergence: bool) -> tuple[float, float]:
@@ -249,3 +276,74 @@ def full_onset(problem, reduced_load: float, kind: str, omega: float, w: Array, 
     mode = mode * np.conj(mode[big]) / abs(mode[big]) ** 2
     part = cluster_participation(shapes, vals, np.ones(len(vals), dtype=bool), np.diag(pencil.mass), TOL_DUPLICATE)
     return (float(root), kind, omega, mode, part), ""
+
+
+def damped_full_onset(problem, reduced_load: float, kind: str, omega: float, mode: NDArray[np.complex128],
+                      phi: Array):
+    """The full damped model's onset near the reduced one, or ``(None, reason)``.
+
+    Flutter (a Hopf point, ``lambda = i omega``): Newton's method on ``T(p, omega) x = 0``,
+    ``T = K0 + p K1 - omega^2 M + i omega (D + G)``, with ``l^H x = 1`` (``l`` the lifted reduced
+    mode ``x0 = Phi y``): each step solves ``T z1 = K1 x`` and ``T z2 = (i (D + G) - 2 omega M) x``
+    with one LU of ``T``, takes ``(dp, domega)`` real from ``dp l^H z1 + domega l^H z2 = -1`` and
+    ``x <- -(dp z1 + domega z2)``; quadratic convergence from the reduced onset, and no product with
+    the stiff ``K0``, only backward-stable solves (as in the undamped route). Divergence
+    (``lambda = 0``): the same with ``omega = 0`` and real ``x``. Then the checks of the undamped
+    route: every eigenvalue of the full first-order operator just below the onset is stable (one
+    dense eigenvalue problem); the participation is that of the null space of ``T`` at the onset
+    (a repeated pair of a symmetric layout gets the basis-independent participation of its
+    eigenspace).
+
+    Returns ``((load, kind, omega, mode, participation), "")`` on success.
+    """
+    mass, k0, k1 = problem.second_order
+    c = problem.damping
+    n = mass.shape[0]
+    divergence = kind == "divergence"
+    x = phi @ (mode.real if divergence else mode)
+    ell = np.conj(x) / np.vdot(x, x)
+    p, w = float(reduced_load), 0.0 if divergence else float(omega)
+    steps, converged = [], False
+    for _ in range(40):
+        t = k0 + p * k1 if divergence else k0 + p * k1 - w * w * mass + 1j * w * c
+        lu = sla.lu_factor(t, check_finite=False)
+        z1 = sla.lu_solve(lu, k1 @ x, check_finite=False)
+        if divergence:
+            dp, dw = -1.0 / float(ell @ z1), 0.0
+            x = -dp * z1
+        else:
+            z2 = sla.lu_solve(lu, (1j * c - 2.0 * w * mass) @ x, check_finite=False)
+            a1, a2 = ell @ z1, ell @ z2
+            dp, dw = np.linalg.solve(np.array([[a1.real, a2.real], [a1.imag, a2.imag]]), np.array([-1.0, 0.0]))
+            x = -(dp * z1 + dw * z2)
+        p, w = p + float(dp), w + float(dw)
+        if not (np.isfinite(p) and np.isfinite(w) and np.isfinite(x).all()):
+            return None, "the Newton iteration on the full model left the finite numbers"
+        size = abs(dp) / abs(p) + abs(dw) / max(abs(w), 1e-300)
+        steps.append(size)
+        # converged to rounding: a step of a few eps, or steps that stopped shrinking (the floor)
+        if size <= 8 * np.finfo(float).eps or (len(steps) > 3 and size >= steps[-2] and steps[-2] <= 1e-10):
+            converged = True
+            break
+    if not converged:
+        return None, "the Newton iteration on the full model did not converge"
+    if abs(p - reduced_load) > 100 * TRUNCATION_TOLERANCE * abs(reduced_load):
+        return None, f"the Newton iteration on the full model went to {p:.10g}, far from the reduced onset"
+    below = p * (1 - 1e-6)
+    if not _first_order_stable(problem, below):
+        return None, f"the full model is already unstable at {below:.10g}, below its onset near the reduced one"
+    # the mode's cluster: the null space of T at the onset, from its smallest singular values up
+    # to the first gap of four orders of magnitude (a repeated pair of a symmetric layout: two);
+    # the rest of the spectrum is at least a frequency away, ten orders above the rounding
+    t = k0 + p * k1 if divergence else k0 + p * k1 - w * w * mass + 1j * w * c
+    _, sv, vh = np.linalg.svd(t)
+    sv, vh = sv[::-1], vh[::-1]
+    k = 1
+    while k < len(sv) and sv[k] <= 1e4 * max(sv[k - 1], 1e-300):
+        k += 1
+    if k == len(sv) or sv[k - 1] > 1e-6 * sv[k]:
+        return None, f"the null space of the full model at the onset is not separated (singular values {sv[:3]})"
+    shapes = vh[:k].conj().T
+    part = cluster_participation(shapes, np.full(k, 1j * w), np.ones(k, dtype=bool), np.diag(mass), TOL_DUPLICATE)
+    lead = x / x[int(np.argmax(np.abs(x)))]
+    return (float(p), kind, abs(w), lead.astype(complex), part), ""

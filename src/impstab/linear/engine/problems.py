@@ -55,8 +55,10 @@ class Problem:
     weights : (n_dof,) array
         Participation weights (mass diagonal), for affine problems.
     second_order : tuple of arrays or None
-        ``(M, K0, K1)`` of an affine undamped second-order problem (for the reduction of large
-        ones, :mod:`impstab.linear.engine.large`).
+        ``(M, K0, K1)`` of an affine second-order problem (for the reduction of large ones,
+        :mod:`impstab.linear.engine.large`).
+    damping : array or None
+        ``D + G`` of an affine damped second-order problem (with ``second_order``).
     provider : object or None
         For the others: ``operators(loads) -> (m, N, N)`` (NaN where no operator exists),
         ``weights(p) -> (n_dof,)``, and ``fold_indicator(p) -> float`` (the square of the
@@ -74,6 +76,7 @@ class Problem:
     weights: Array | None = None
     provider: object | None = None
     second_order: tuple | None = None
+    damping: Array | None = None
 
     @property
     def affine(self) -> bool:
@@ -254,11 +257,11 @@ def second_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: in
         if n <= LARGE_ORDER:  # a large one may be reduced: its operators are formed only if needed
             problem.operators()
         return problem
-    else:
-        a0 = state_matrices(m, d + g, k0)
-        a1 = np.zeros_like(a0)
-        a1[n:, :n] = -np.linalg.solve(m, k1)
-    return Problem(False, p_min, p_max, n_scan, a0.shape[0], n, a0, a1, np.diag(m).copy())
+    a0 = state_matrices(m, d + g, k0)
+    a1 = np.zeros_like(a0)
+    a1[n:, :n] = -np.linalg.solve(m, k1)
+    return Problem(False, p_min, p_max, n_scan, a0.shape[0], n, a0, a1, np.diag(m).copy(), second_order=(m, k0, k1),
+                   damping=d + g)
 
 
 def first_order_problem(family, p_max: float, *, p_min: float = 0.0, n_scan: int = 64) -> Problem:

@@ -253,11 +253,13 @@ def solve(problems: list[Problem], *, all_crossings: bool = False, chunk: int = 
 
 
 def _solve_large(problem: Problem, chunk: int) -> tuple[Outcome | None, str]:
-    """A large undamped problem by modal reduction with error checks (:mod:`~impstab.linear.engine.large`).
+    """A large second-order problem by modal reduction with error checks
+    (:mod:`~impstab.linear.engine.large`).
 
     Returns the outcome, or None and the reason where the problem must be solved dense.
     """
-    n = problem.order
+    n = problem.second_order[0].shape[0]
+    method = "coalescence" if problem.undamped else "hopf"
     m = large.BASIS
     evaluations = 0
     while True:
@@ -269,22 +271,25 @@ def _solve_large(problem: Problem, chunk: int) -> tuple[Outcome | None, str]:
         if small.load is None and big.load is None:
             if not large.stable_at(problem, problem.p_max):
                 return None, "the full model is unstable at p_max although the reduced models are not"
-            return Outcome(None, "none", None, None, None, (), evaluations + 1, big.warnings, method="coalescence"), ""
+            return Outcome(None, "none", None, None, None, (), evaluations + 1, big.warnings, method=method), ""
         if small.load is not None and big.load is not None and small.kind == big.kind \
                 and abs(small.load - big.load) <= large.TRUNCATION_TOLERANCE * abs(big.load):
             break
         if 2 * m2 > n:
             return None, f"the onsets with {m} and {m2} modes disagree"
         m = m2
-    width = max(10 * abs(small.load - big.load) / abs(big.load), 1e-8)
     try:
-        onset, reason = large.full_onset(problem, big.load, big.kind, big.omega, w, phi, width)
-    except np.linalg.LinAlgError as exc:  # a singular projected matrix in the subspace iteration
-        return None, f"the shift-invert subspace iteration failed ({exc})"
+        if problem.undamped:
+            width = max(10 * abs(small.load - big.load) / abs(big.load), 1e-8)
+            onset, reason = large.full_onset(problem, big.load, big.kind, big.omega, w, phi, width)
+        else:
+            onset, reason = large.damped_full_onset(problem, big.load, big.kind, big.omega, big.mode, phi)
+    except np.linalg.LinAlgError as exc:  # a singular matrix in the subspace or Newton iteration
+        return None, f"the iteration on the full model failed ({exc})"
     if onset is None:
         return None, reason
     p, kind, omega, mode, part = onset
-    return Outcome(p, kind, omega, mode, part, (), evaluations + 1, big.warnings, method="coalescence"), ""
+    return Outcome(p, kind, omega, mode, part, (), evaluations + 1, big.warnings, method=method), ""
 
 
 def _warning(load: float) -> str:
