@@ -329,7 +329,7 @@ def damped_full_onset(problem, reduced_load: float, kind: str, omega: float, mod
         return None, "the Newton iteration on the full model did not converge"
     if abs(p - reduced_load) > 100 * TRUNCATION_TOLERANCE * abs(reduced_load):
         return None, f"the Newton iteration on the full model went to {p:.10g}, far from the reduced onset"
-    below = p * (1 - 1e-6)
+    below = p - 1e-6 * abs(p)  # towards p_min
     if not _first_order_stable(problem, below):
         return None, f"the full model is already unstable at {below:.10g}, below its onset near the reduced one"
     # the mode's cluster: the null space of T at the onset, from its smallest singular values up
