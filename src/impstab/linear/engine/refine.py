@@ -677,7 +677,9 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         break
                     if not np.isnan(root):
                         # the onset values: cluster at the root (or at the last point evaluated, where
-                        # that is within 1e-12 of it), distinct modes at a (stable side)
+                        # that is within 1e-12 of it); where frequencies merge (undamped, or on the
+                        # imaginary axis) the distinct modes come from a (stable side): at the root
+                        # they are one defective mode
                         point[0] = last if abs(root - last) <= 1e-12 * abs(root) else root
                         code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
                         if code == PROVIDER_ERROR:
@@ -688,13 +690,14 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                             cols[i] = sel[i]
                         shapes, values = _take(c_vals[s], c_vecs[s], cols, k, n_dof)
                         vals_r, vecs_r = c_vals[s].copy(), c_vecs[s].copy()
-                        point[0] = a
-                        code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
-                        if code == PROVIDER_ERROR:
-                            failed = True
-                            break
-                        if code != NOT_FINITE and select(c_vecs[s], vc, wc, k, sel, share, work[0]):
-                            shapes, values = _take(c_vals[s], c_vecs[s], sel, k, n_dof)
+                        if undamped or coalesce:
+                            point[0] = a
+                            code, s = spectrum(jobs, j, point, DECOMPOSITION, cache, ws, ev)
+                            if code == PROVIDER_ERROR:
+                                failed = True
+                                break
+                            if code != NOT_FINITE and select(c_vecs[s], vc, wc, k, sel, share, work[0]):
+                                shapes, values = _take(c_vals[s], c_vecs[s], sel, k, n_dof)
                         break
                     if step_back:
                         new_a = min(max(a + (a - b), lo_lim), hi_lim)
