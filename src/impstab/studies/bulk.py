@@ -36,7 +36,7 @@ from ..model.mounts import axial_shear_matrix, condense, ring_positions
 from ..model.schema import ModelFile
 from .paths import _location, resolve_path, variant_dict
 
-__all__ = ["FIELDS", "BulkDesigns", "assemble_bulk"]
+__all__ = ["FIELDS", "BulkDesigns", "assemble_bulk", "variant_model"]
 
 Array = NDArray[np.float64]
 
@@ -211,6 +211,12 @@ def assemble_bulk(base: dict, segments: Sequence[tuple], columns: Sequence[NDArr
     return BulkDesigns(stack, n, functools.partial(_variant_family, base, segments, columns, name=name))
 
 
+def variant_model(base: dict, segments, columns, j: int, *, name: str):
+    """The model of design ``j`` of a chunk (``columns``: the chunk's parameter values), assembled
+    the per-variant way: from its variant model file (raises ``ModelError``)."""
+    return model_from_dict(variant_dict(base, segments, [c[j] for c in columns]), name=name)
+
+
 def _variant_family(base: dict, segments, columns, j: int, *, name: str) -> ModelFamily:
     """The family of design ``j``, assembled the per-variant way (only if its engine is needed)."""
-    return ModelFamily(model_from_dict(variant_dict(base, segments, [c[j] for c in columns]), name=name))
+    return ModelFamily(variant_model(base, segments, columns, j, name=name))

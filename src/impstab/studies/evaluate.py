@@ -19,8 +19,7 @@ from numpy.typing import NDArray
 from .._jit import require_compiled
 from ..errors import ModelError
 from ..linear.batch import STATUSES, critical_thrust_batch
-from ..model.assemble import model_from_dict
-from .bulk import assemble_bulk
+from .bulk import assemble_bulk, variant_model
 from .isolation import IsolationSettings, isolation_outputs
 from .paths import variant_dict
 from .schema import ISOLATION_OUTPUTS, POSTCRITICAL_OUTPUTS
@@ -173,8 +172,7 @@ def _evaluate(task: ChunkTask) -> ChunkResult:
 
 def _variant(task: ChunkTask, j: int):
     """The model of design ``j`` of the chunk, from its variant model file (raises ``ModelError``)."""
-    return model_from_dict(variant_dict(task.base_model, task.segments, [c[j] for c in task.columns]),
-                           name=task.model_name)
+    return variant_model(task.base_model, task.segments, task.columns, j, name=task.model_name)
 
 
 def _postcritical(models, res, failed, message, branch: bool) -> dict[str, object]:
