@@ -298,15 +298,17 @@ def damped_full_onset(problem, reduced_load: float, kind: str, omega: float, mod
     """
     mass, k0, k1 = problem.second_order
     c = problem.damping
-    n = mass.shape[0]
     divergence = kind == "divergence"
+
+    def dynamic_stiffness(p: float, w: float):
+        return k0 + p * k1 if divergence else k0 + p * k1 - w * w * mass + 1j * w * c
+
     x = phi @ (mode.real if divergence else mode)
     ell = np.conj(x) / np.vdot(x, x)
     p, w = float(reduced_load), 0.0 if divergence else float(omega)
-    steps, converged = [], False
-    for _ in range(40):
-        t = k0 + p * k1 if divergence else k0 + p * k1 - w * w * mass + 1j * w * c
-        lu = sla.lu_factor(t, check_finite=False)
+    previous, converged = np.inf, False
+    for it in range(40):
+        lu = sla.lu_factor(dynamic_stiffness(p, w), check_finite=False)
         z1 = sla.lu_solve(lu, k1 @ x, check_finite=False)
         if divergence:
             dp, dw = -1.0 / float(ell @ z1), 0.0
@@ -320,11 +322,11 @@ def damped_full_onset(problem, reduced_load: float, kind: str, omega: float, mod
         if not (np.isfinite(p) and np.isfinite(w) and np.isfinite(x).all()):
             return None, "the Newton iteration on the full model left the finite numbers"
         size = abs(dp) / abs(p) + abs(dw) / max(abs(w), 1e-300)
-        steps.append(size)
         # converged to rounding: a step of a few eps, or steps that stopped shrinking (the floor)
-        if size <= 8 * np.finfo(float).eps or (len(steps) > 3 and size >= steps[-2] and steps[-2] <= 1e-10):
+        if size <= 8 * np.finfo(float).eps or (it >= 3 and size >= previous and previous <= 1e-10):
             converged = True
             break
+        previous = size
     if not converged:
         return None, "the Newton iteration on the full model did not converge"
     if abs(p - reduced_load) > 100 * TRUNCATION_TOLERANCE * abs(reduced_load):
@@ -335,8 +337,7 @@ def damped_full_onset(problem, reduced_load: float, kind: str, omega: float, mod
     # the mode's cluster: the null space of T at the onset, from its smallest singular values up
     # to the first gap of four orders of magnitude (a repeated pair of a symmetric layout: two);
     # the rest of the spectrum is at least a frequency away, ten orders above the rounding
-    t = k0 + p * k1 if divergence else k0 + p * k1 - w * w * mass + 1j * w * c
-    _, sv, vh = np.linalg.svd(t)
+    _, sv, vh = np.linalg.svd(dynamic_stiffness(p, w))
     sv, vh = sv[::-1], vh[::-1]
     k = 1
     while k < len(sv) and sv[k] <= 1e4 * max(sv[k - 1], 1e-300):
