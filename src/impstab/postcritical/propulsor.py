@@ -217,9 +217,11 @@ def propulsor_postcritical(
     -------
     PostcriticalResult
     """
+    from .._jit import require_compiled
     from ..limits import check_number
     from ..linear.critical_thrust import critical_thrust
 
+    require_compiled()  # a Hopf analysis and a branch of cycles: seconds of kernel time
     t_max = check_number("thrust_max", thrust_max if thrust_max is not None else model.analysis.thrust_max, "thrust")
     requested = _check_thrusts(thrusts, t_max)
     crit = critical if critical is not None else critical_thrust(model, thrust_max=t_max)

@@ -92,6 +92,9 @@ def report(
                             target_margin=None if target_margin is None else float(target_margin))
     prov = make_provenance(origin, described, command or _python_call(source, path, sections, simulation))
     if kind == "model":
+        from .._jit import require_compiled
+
+        require_compiled()  # a model's report computes loci, time histories and cycles: seconds of kernel time
         ctx = ModelContext(obj, options)
         builders = MODEL_SECTIONS
         name = obj.name
