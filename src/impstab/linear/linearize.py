@@ -323,6 +323,25 @@ class ModelFamily:
             (m, d, g, k0), k1 = self._grow(m, d, g, k0), self._grow_load(k1)
         return m, d, g, k0, k1
 
+    def gyroscopic_law_parts(self):
+        """``(M, D, G1, K0, K1, law)`` when K is exactly affine in T and the gyroscopic matrix follows
+        the propeller's ``sqrt-thrust`` speed law, ``G(T) = law(T) G1``: ``G1`` at the operating
+        speed, ``law(T) = sqrt(max(T, 0) / operating)`` (vectorized); else None (a constant speed
+        is affine: :meth:`affine_parts`)."""
+        pk = self.packed
+        if self._affine is None or pk.speed_law != "sqrt-thrust" or pk.polar_inertia * pk.speed == 0.0:  # type: ignore[attr-defined]
+            return None
+        m, d, k0, k1, g1 = self._affine  # type: ignore[attr-defined]
+        g = g1 * pk.polar_inertia * pk.speed
+        if self.internal is not None:
+            (m, d, g, k0), k1 = self._grow(m, d, g, k0), self._grow_load(k1)
+        operating = float(pk.operating)
+
+        def law(thrusts: Array) -> Array:
+            return np.sqrt(np.maximum(np.asarray(thrusts, dtype=float), 0.0) / operating)
+
+        return m, d, g, k0, k1, law
+
     def _grow(self, m, d, g, k, rotations=None):
         stack = lambda a: np.asarray(a, dtype=float)[None]  # noqa: E731
         return tuple(a[0] for a in self.internal.augment(stack(m), stack(d), stack(g), stack(k), rotations))

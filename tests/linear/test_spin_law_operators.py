@@ -1,0 +1,74 @@
+"""A propeller whose speed grows as sqrt(T): the engine's operators ``A0 + p A1 + sqrt(p / T_op) A2``.
+
+With ``speed_law = "sqrt-thrust"`` the gyroscopic matrix is ``G(T) = sqrt(T / T_op) G_op`` and the
+family is not affine; its stiffness still is, so the engine forms the three operators once
+(``problems._GyroscopicLawProvider``) instead of linearizing the model at every load. Independent
+answers:
+
+* the operators equal the state matrix ``[[0, I], [-M^-1 K, -M^-1 (D + G)]]`` of the model's
+  linearization (``ModelFamily.matrices``) at loads across the range, to rounding;
+* the undamped companion of examples/imp_isolation.toml (gyroscopic and conservative) loses
+  stability by a coalescence on the imaginary axis, past which ``Re(lambda)^2`` grows linearly in
+  the thrust: ``Re(lambda)^2 / (T - T_c)`` from LAPACK's eigenvalues is the same at
+  ``T - T_c = 1e-3`` and ``0.1 N`` (measured 1.3e-7 apart, the curvature of the branch); an
+  error e in ``T_c`` would part them by ``e / 1e-3``, so ``T_c`` is right to about 1e-10 N. The linearization at every load had located this onset only by bisection on the
+  stability tolerance, 0.14 N (1e-5) high, with a warning;
+* the damped critical thrusts equal those through the linearization at every load to 1e-12.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import impstab
+from impstab.linear import critical_load_family
+from impstab.linear.eigen import state_matrices
+from impstab.linear.engine import problems
+from impstab.linear.linearize import ModelFamily
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.mark.parametrize("name,damped", [("imp_isolation", True), ("imp_isolation", False), ("imp_damped", True)])
+def test_operators_equal_the_state_matrix_of_the_linearization(name, damped):
+    model = impstab.load_model(EXAMPLES / f"{name}.toml")
+    fam = ModelFamily(model, damped=damped)
+    problem = problems.second_order_problem(fam, model.analysis.thrust_max)
+    assert isinstance(problem.provider, problems._GyroscopicLawProvider)
+    loads = np.array([0.0, 1.0, 0.37 * model.thrust.operating, model.thrust.operating, model.analysis.thrust_max])
+    m, d, g, k = fam.matrices(loads)
+    expected = state_matrices(m, d + g, k)
+    got = problem.provider.operators(loads)
+    scale = np.abs(expected).max(axis=(1, 2))
+    assert np.all(np.abs(got - expected).max(axis=(1, 2)) <= 1e-14 * scale)
+    assert np.any(g[1:] != 0.0) and not np.any(g[0])  # the gyroscopic part follows the load, zero at rest
+
+
+def test_the_conservative_companion_loses_stability_where_the_frequencies_coalesce():
+    model = impstab.load_model(EXAMPLES / "imp_isolation.toml")
+    fam = ModelFamily(model, damped=False)
+    res = critical_load_family(fam, model.analysis.thrust_max)
+    assert res.kind == "flutter" and res.warnings == ()
+    ratios = []
+    for step in (1e-3, 0.1):
+        m, d, g, k = (x[0] for x in fam.matrices(np.array([res.load + step])))
+        grow = np.linalg.eigvals(state_matrices(m, d + g, k)).real.max()
+        ratios.append(grow**2 / step)
+    assert abs(ratios[0] / ratios[1] - 1) < 1e-6  # measured 1.3e-7
+    m, d, g, k = (x[0] for x in fam.matrices(np.array([res.load * (1 - 1e-9)])))
+    below = np.linalg.eigvals(state_matrices(m, d + g, k))
+    assert below.real.max() < 1e-9 * np.abs(below).max()  # marginally stable just below
+
+
+@pytest.mark.parametrize("name", ["imp_isolation", "imp_damped"])
+def test_damped_critical_thrust_equals_the_linearization_at_every_load(name, monkeypatch):
+    model = impstab.load_model(EXAMPLES / f"{name}.toml")
+    res = impstab.critical_thrust(model)
+    monkeypatch.setattr(ModelFamily, "gyroscopic_law_parts", lambda self: None)
+    general = impstab.critical_thrust(model)
+    assert res.kind == general.kind == "flutter"
+    assert abs(res.thrust / general.thrust - 1) < 1e-12 and abs(res.omega / general.omega - 1) < 1e-12
+    np.testing.assert_allclose(res.participation, general.participation, atol=1e-12)
