@@ -12,10 +12,14 @@ Where it comes from:
   a user function), called from the compiled code in object mode (numba ``objmode``), one call
   per scan chunk or per load.
 
-Eigenvalues and eigen-decompositions come from the compiled small-matrix routines
-(:mod:`impstab.linear.small_eig`, :mod:`impstab.linear.small_eigvec`) up to order
-:data:`~impstab.linear.small_eig.MAX_ORDER`; larger operators, and any that the compiled
-routines cannot resolve (no convergence, a defective block), go to LAPACK through NumPy.
+Eigenvalues come from the compiled small-matrix QR (:mod:`impstab.linear.small_eig`) up to
+order :data:`~impstab.linear.small_eig.MAX_ORDER`; eigen-decompositions from the compiled
+inverse iteration (:mod:`impstab.linear.small_eigvec`) on the decoupled blocks of affine
+problems, where a symmetric layout's doubled eigenvalues lie in blocks of their own. Larger
+operators, any that the compiled routines cannot resolve (no convergence, a defective block) and
+the decompositions of operators without a block structure (providers': inverse iteration from
+one start vector returns nearly parallel vectors for the two copies of a doubled eigenvalue) go
+to LAPACK through NumPy.
 
 :func:`spectrum` is the one entry point of the scan and the refinement (numba links a
 function's callees into it and optimises them again, so the engine keeps a single function
@@ -129,14 +133,10 @@ def _lapack_vectors(op, vals, vecs, inv):
 def workspace(n, chunk):
     """Work arrays of :func:`spectrum` for operators of order ``n``, up to ``chunk`` loads a call
     (and, last, ``n`` floats of scratch for the classification of its eigenvalues)."""
-    order = np.arange(n).reshape(1, n)
-    starts = np.full((1, n + 1), n, dtype=np.int64)
-    starts[0, 0] = 0
     chunk = max(chunk, 2)
     return (eig_workspace(n), np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n),
-            np.empty((chunk, n, n)), np.zeros((1, n, n)), order, starts, np.ones(1, dtype=np.int64),
-            np.empty((chunk, n), dtype=np.complex128), np.empty(chunk, dtype=np.bool_),
-            np.zeros((1, n), dtype=np.int64), np.empty(n))
+            np.empty((chunk, n, n)), np.empty((chunk, n), dtype=np.complex128), np.empty(chunk, dtype=np.bool_),
+            np.empty(n))
 
 
 @njit(cache=True, error_model="numpy")
@@ -207,8 +207,8 @@ VALUES, DECOMPOSITION = np.bool_(False), np.bool_(True)
 def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     """Eigenvalues or a decomposition of problem ``j``; returns ``(status, slot)``.
 
-    ``vectors`` :data:`VALUES` (False): the eigenvalues at every load of ``loads`` into ``ws[10][:m]``, with
-    ``ws[11][i]`` set where the operator is not finite (its eigenvalues are then those of the
+    ``vectors`` :data:`VALUES` (False): the eigenvalues at every load of ``loads`` into ``ws[6][:m]``, with
+    ``ws[7][i]`` set where the operator is not finite (its eigenvalues are then those of the
     identity, a stable placeholder); the status is 0, or :data:`PROVIDER_ERROR`.
 
     ``vectors`` :data:`DECOMPOSITION` (True): the decomposition at ``loads[0]`` (values, unit eigenvectors, their
@@ -221,7 +221,7 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     compiled = jobs.ints[j, AFFINE] == 1 and jobs.ints[j, LARGEST] <= MAX_ORDER
     ops = ws[5]
     if not vectors:
-        vals, lost = ws[10], ws[11]
+        vals, lost = ws[6], ws[7]
         if compiled:
             w, v, wr, wi = ws[1], ws[2], ws[3], ws[4]
             for i in range(m):
@@ -273,11 +273,11 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
         c_status[s] = NOT_FINITE
         vals[:] = np.nan
         return NOT_FINITE, s
-    # the one design of ws[6..9] as an int64, as ``j`` above: numba compiles a callee once per
-    # argument type, and a literal 0 is a type of its own (``Literal[int](0)``)
-    if n <= MAX_ORDER and block_eig_at(ops[:1], ws[6], np.int64(0), 0.0, ws[7], ws[8], ws[9], ws[12], vals, vecs,
-                                       inv, ws[0]):
-        c_status[s] = OK
-        return OK, s
+    # an operator without its block structure (a provider's, or an affine one whose blocks failed)
+    # goes to LAPACK: the compiled inverse iteration starts every eigenvector from one vector, so
+    # the two copies of an eigenvalue that a symmetric layout doubles (separated into blocks of
+    # their own on the affine route) come out nearly parallel, and near a coalescence the
+    # selection of the merging modes then fails (the conservative companion of
+    # examples/imp_isolation.toml: shares of 0.64 outside the cluster, LAPACK's 0.064)
     c_status[s] = _lapack_vectors(ops[0], vals, vecs, inv)
     return c_status[s], s
