@@ -82,3 +82,23 @@ def test_damped_critical_thrust_equals_the_linearization_at_every_load(name, mon
     assert res.kind == general.kind == "flutter"
     assert abs(res.thrust / general.thrust - 1) < 1e-12 and abs(res.omega / general.omega - 1) < 1e-12
     np.testing.assert_allclose(res.participation, general.participation, atol=1e-12)
+
+
+def test_the_command_line_and_a_compiled_process_give_the_same_undamped_onset():
+    """A fresh ``impstab critical`` runs its kernels as Python (LAPACK's decompositions); a study
+    or any long work compiles them: both must reach the same onset (they were 9.6e-6 apart)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    path = EXAMPLES / "imp_isolation.toml"
+    out = subprocess.run([sys.executable, "-m", "impstab", "critical", str(path), "--json"], capture_output=True,
+                         text=True, env=dict(os.environ, IMPSTAB_JIT="auto", MPLBACKEND="Agg"), timeout=120)
+    assert out.returncode == 0, out.stderr
+    line = json.loads(out.stdout)
+    require_compiled()
+    res = impstab.critical_thrust(impstab.load_model(path))
+    assert line["warnings"] == [] and res.warnings == ()
+    assert abs(res.undamped_thrust / line["undamped_critical_thrust"] - 1) < 1e-12
+    assert abs(res.thrust / line["critical_thrust"] - 1) < 1e-12
