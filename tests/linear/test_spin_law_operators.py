@@ -13,10 +13,9 @@ answers:
   gives the onset independently of the engine (15000.16178 N; the curvature of the branch leaves
   about 4e-9 N).
   The engine's exact indicator lands on it to 3e-13 with compiled kernels (which take the
-  decompositions of operators without a block structure from LAPACK: the compiled inverse
-  iteration gave the doubled pairs of this symmetric ring nearly parallel vectors, the exact
-  route refused the bracket, and bisection on the stability tolerance left the onset 1e-5 high,
-  with a warning);
+  decompositions of operators without a block structure from LAPACK: with the compiled inverse
+  iteration's basis of the doubled pair that merges, the selection of the merging modes failed,
+  and bisection on the stability tolerance left the onset 1e-5 high, with a warning);
 * the damped critical thrusts equal those through the linearization at every load to 1e-12.
 """
 

@@ -17,9 +17,11 @@ order :data:`~impstab.linear.small_eig.MAX_ORDER`; eigen-decompositions from the
 inverse iteration (:mod:`impstab.linear.small_eigvec`) on the decoupled blocks of affine
 problems, where a symmetric layout's doubled eigenvalues lie in blocks of their own. Larger
 operators, any that the compiled routines cannot resolve (no convergence, a defective block) and
-the decompositions of operators without a block structure (providers': inverse iteration from
-one start vector returns nearly parallel vectors for the two copies of a doubled eigenvalue) go
-to LAPACK through NumPy.
+the decompositions of operators without a block structure (providers') go to LAPACK through
+NumPy: the vectors a process gets while its kernels run as Python, so that a study and a single
+model select the same modes. Within a doubled eigenvalue's eigenspace the basis is arbitrary, and
+where only one combination of it merges with another mode, the selection of the merging modes by
+their oblique shares depends on that basis (see :func:`~impstab.linear.engine.refine.select`).
 
 :func:`spectrum` is the one entry point of the scan and the refinement (numba links a
 function's callees into it and optimises them again, so the engine keeps a single function
@@ -274,10 +276,9 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
         vals[:] = np.nan
         return NOT_FINITE, s
     # an operator without its block structure (a provider's, or an affine one whose blocks failed)
-    # goes to LAPACK: the compiled inverse iteration starts every eigenvector from one vector, so
-    # the two copies of an eigenvalue that a symmetric layout doubles (separated into blocks of
-    # their own on the affine route) come out nearly parallel, and near a coalescence the
-    # selection of the merging modes then fails (the conservative companion of
-    # examples/imp_isolation.toml: shares of 0.64 outside the cluster, LAPACK's 0.064)
+    # goes to LAPACK, as while the kernels run as Python: a doubled eigenvalue's basis is then the
+    # same in every process, and the selection of merging modes with it (the conservative
+    # companion of examples/imp_isolation.toml: with the compiled inverse iteration's basis the two
+    # copies had shares of 0.94 and 0.64 in the merging cluster, LAPACK's 0.99 and 0.064)
     c_status[s] = _lapack_vectors(ops[0], vals, vecs, inv)
     return c_status[s], s
