@@ -8,10 +8,10 @@ values once the mesh-point values are known, and ``n`` condensed equations
 ``A_i v_i + B_i v_(i+1) + Hb_i mu = (Q_i^T r_i)_bottom`` (the same ``A_i``, ``B_i`` as the Floquet
 reduction uses). The two border rows (phase condition, continuation constraint) are condensed by
 substituting the interior values. What remains is a cyclic block-bidiagonal system of ``N n + 2``
-unknowns with two dense rows and columns, solved by SuperLU (minimum-degree ordering of ``A^T + A``); the interior values follow by
-back-substitution. This is AUTO's strategy (Doedel, Keller and Kernevez 1991) with QR in place of
-Gaussian elimination; it is ``m`` times smaller than the full system and its factorization costs a
-small fraction of the full sparse one.
+unknowns with two dense rows and columns, solved by SuperLU (minimum-degree ordering of
+``A^T + A``); the interior values follow by back-substitution. This is AUTO's strategy (Doedel,
+Keller and Kernevez 1991) with QR in place of Gaussian elimination; it is ``m`` times smaller than
+the full system and its factorization costs a small fraction of the full sparse one.
 """
 
 from __future__ import annotations
