@@ -12,10 +12,10 @@ answers:
   the thrust: extrapolated to zero from LAPACK's eigenvalues at 15000.20 N and 15000.25 N, that
   gives the onset independently of the engine (15000.16178 N; the curvature of the branch leaves
   about 4e-9 N).
-  The engine's exact indicator lands on it to 3e-13 with compiled kernels (which take the
-  decompositions of operators without a block structure from LAPACK: with the compiled inverse
-  iteration's basis of the doubled pair that merges, the selection of the merging modes failed,
-  and bisection on the stability tolerance left the onset 1e-5 high, with a warning);
+  The engine's exact indicator lands on it to 3e-13 with compiled kernels (which decompose a
+  whole operator with a repeated eigenvalue by LAPACK: with the compiled inverse iteration's
+  basis of the doubled pair that merges, the selection of the merging modes failed, and bisection
+  on the stability tolerance left the onset 1e-5 high, with a warning);
 * the damped critical thrusts equal those through the linearization at every load to 1e-12.
 """
 
@@ -57,7 +57,7 @@ def _eigenvalues(fam, thrust):
 
 
 def test_the_conservative_companion_loses_stability_where_the_frequencies_coalesce():
-    require_compiled()  # the compiled decompositions (run as Python, the kernels take LAPACK's)
+    require_compiled()  # the compiled kernels (run as Python, they take LAPACK's decompositions)
     model = impstab.load_model(EXAMPLES / "imp_isolation.toml")
     fam = ModelFamily(model, damped=False)
     res = critical_load_family(fam, model.analysis.thrust_max)

@@ -512,7 +512,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
     # the cache's arrays and the one-point views taken once, not in the loops (each taken costs two
     # atomic reference counts)
     c_vals, c_vecs, c_inv = cache[2], cache[3], cache[4]
-    vals1, lost1, scratch = ws[6][:1], ws[7][:1], ws[8]
+    vals1, lost1, scratch = ws[10][:1], ws[11][:1], ws[13]
     for j in range(len(jobs.ints)):
         if counts[j, STATUS] != 0:
             continue

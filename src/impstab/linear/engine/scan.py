@@ -308,7 +308,7 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                np.empty(n), np.empty(n))
     counter = np.zeros(3, dtype=np.int64)
     # the one-point views made once, not in the loops (each view made costs two atomic reference counts)
-    vals1, lost1, cplx1, neg1, scratch = ws[6][:1], ws[7][:1], cplx[:1], neg[:1], ws[8]
+    vals1, lost1, cplx1, neg1, scratch = ws[10][:1], ws[11][:1], cplx[:1], neg[:1], ws[13]
     for j in range(count):
         cache[0][:] = np.nan  # a new problem: nothing cached
         counter[:] = 0
@@ -331,10 +331,10 @@ def scan_stack(jobs, all_crossings, onsets, counts):
                         failed = True
                         break
                     m = stop - known
-                    _classify(ws[6][:m], ws[7][:m], undamped, flags[known:stop], ind[known:stop], cplx[:m], neg[:m], scratch)
+                    _classify(ws[10][:m], ws[11][:m], undamped, flags[known:stop], ind[known:stop], cplx[:m], neg[:m], scratch)
                     for i in range(m):  # loops, not slice assignments: numba compiles a
                         for c in range(n):  # broadcast check (and its error message) for those
-                            vals_grid[known + i, c] = ws[6][i, c]
+                            vals_grid[known + i, c] = ws[10][i, c]
                     known = stop
                 if failed or flags[0]:
                     break

@@ -12,16 +12,19 @@ Where it comes from:
   a user function), called from the compiled code in object mode (numba ``objmode``), one call
   per scan chunk or per load.
 
-Eigenvalues come from the compiled small-matrix QR (:mod:`impstab.linear.small_eig`) up to
-order :data:`~impstab.linear.small_eig.MAX_ORDER`; eigen-decompositions from the compiled
-inverse iteration (:mod:`impstab.linear.small_eigvec`) on the decoupled blocks of affine
-problems, where a symmetric layout's doubled eigenvalues lie in blocks of their own. Larger
-operators, any that the compiled routines cannot resolve (no convergence, a defective block) and
-the decompositions of operators without a block structure (providers') go to LAPACK through
-NumPy: the vectors a process gets while its kernels run as Python, so that a study and a single
-model select the same modes. Within a doubled eigenvalue's eigenspace the basis is arbitrary, and
-where only one combination of it merges with another mode, the selection of the merging modes by
-their oblique shares depends on that basis (see :func:`~impstab.linear.engine.refine.select`).
+Eigenvalues and eigen-decompositions come from the compiled small-matrix routines
+(:mod:`impstab.linear.small_eig`, :mod:`impstab.linear.small_eigvec`) up to order
+:data:`~impstab.linear.small_eig.MAX_ORDER`; larger operators, and any that the compiled
+routines cannot resolve (no convergence, a defective block), go to LAPACK through NumPy. So does
+the decomposition of a whole operator (a provider's, or an affine one whose blocks failed) with a
+repeated eigenvalue: its vectors are then one basis of the eigenspace among many, and where only
+one combination of it merges with another mode the refinement's selection of the merging modes,
+by each vector's share in the cluster's subspace, depends on the basis. LAPACK's is the one a
+process gets while its kernels run as Python (the conservative companion of
+``examples/imp_isolation.toml``, whose doubled pair merges with a mode: shares of 0.94 and 0.64
+with the compiled inverse iteration's basis, 0.99 and 0.064 with LAPACK's; the exact route refused
+the first, and a study put the onset 1e-5 away from the command line's). The block route of affine
+problems puts a symmetric layout's copies in blocks of their own.
 
 :func:`spectrum` is the one entry point of the scan and the refinement (numba links a
 function's callees into it and optimises them again, so the engine keeps a single function
@@ -135,10 +138,14 @@ def _lapack_vectors(op, vals, vecs, inv):
 def workspace(n, chunk):
     """Work arrays of :func:`spectrum` for operators of order ``n``, up to ``chunk`` loads a call
     (and, last, ``n`` floats of scratch for the classification of its eigenvalues)."""
+    order = np.arange(n).reshape(1, n)
+    starts = np.full((1, n + 1), n, dtype=np.int64)
+    starts[0, 0] = 0
     chunk = max(chunk, 2)
     return (eig_workspace(n), np.empty((n, n)), np.empty(n), np.empty(n), np.empty(n),
-            np.empty((chunk, n, n)), np.empty((chunk, n), dtype=np.complex128), np.empty(chunk, dtype=np.bool_),
-            np.empty(n))
+            np.empty((chunk, n, n)), np.zeros((1, n, n)), order, starts, np.ones(1, dtype=np.int64),
+            np.empty((chunk, n), dtype=np.complex128), np.empty(chunk, dtype=np.bool_),
+            np.zeros((1, n), dtype=np.int64), np.empty(n))
 
 
 @njit(cache=True, error_model="numpy")
@@ -199,6 +206,23 @@ def _values_of(op, ws, out):
     _lapack_values(op, out)
 
 
+#: eigenvalues closer than this (relative to the largest magnitude) count as one repeated eigenvalue
+REPEATED = 1e-8
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _repeated(vals, n):
+    """Whether two of ``vals[:n]`` are equal to :data:`REPEATED` of the largest magnitude."""
+    scale = 0.0
+    for i in range(n):
+        scale = max(scale, abs(vals[i]))
+    for i in range(n):
+        for k in range(i):
+            if abs(vals[i] - vals[k]) <= REPEATED * scale:
+                return True
+    return False
+
+
 #: the ``vectors`` argument of :func:`spectrum`. NumPy booleans, not ``False`` and ``True``: numba
 #: compiles a compiled callee once more for each literal constant it is passed (``Literal[bool]``),
 #: but once for a NumPy boolean of either value
@@ -209,8 +233,8 @@ VALUES, DECOMPOSITION = np.bool_(False), np.bool_(True)
 def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     """Eigenvalues or a decomposition of problem ``j``; returns ``(status, slot)``.
 
-    ``vectors`` :data:`VALUES` (False): the eigenvalues at every load of ``loads`` into ``ws[6][:m]``, with
-    ``ws[7][i]`` set where the operator is not finite (its eigenvalues are then those of the
+    ``vectors`` :data:`VALUES` (False): the eigenvalues at every load of ``loads`` into ``ws[10][:m]``, with
+    ``ws[11][i]`` set where the operator is not finite (its eigenvalues are then those of the
     identity, a stable placeholder); the status is 0, or :data:`PROVIDER_ERROR`.
 
     ``vectors`` :data:`DECOMPOSITION` (True): the decomposition at ``loads[0]`` (values, unit eigenvectors, their
@@ -223,7 +247,7 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
     compiled = jobs.ints[j, AFFINE] == 1 and jobs.ints[j, LARGEST] <= MAX_ORDER
     ops = ws[5]
     if not vectors:
-        vals, lost = ws[6], ws[7]
+        vals, lost = ws[10], ws[11]
         if compiled:
             w, v, wr, wi = ws[1], ws[2], ws[3], ws[4]
             for i in range(m):
@@ -275,10 +299,13 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
         c_status[s] = NOT_FINITE
         vals[:] = np.nan
         return NOT_FINITE, s
-    # an operator without its block structure (a provider's, or an affine one whose blocks failed)
-    # goes to LAPACK, as while the kernels run as Python: a doubled eigenvalue's basis is then the
-    # same in every process, and the selection of merging modes with it (the conservative
-    # companion of examples/imp_isolation.toml: with the compiled inverse iteration's basis the two
-    # copies had shares of 0.94 and 0.64 in the merging cluster, LAPACK's 0.99 and 0.064)
+    # the one design of ws[6..9] as an int64, as ``j`` above: numba compiles a callee once per
+    # argument type, and a literal 0 is a type of its own (``Literal[int](0)``). A repeated
+    # eigenvalue's vectors are one basis of its eigenspace among many: those go to LAPACK, the
+    # basis a process gets while its kernels run as Python (see the module's docstring)
+    if n <= MAX_ORDER and block_eig_at(ops[:1], ws[6], np.int64(0), 0.0, ws[7], ws[8], ws[9], ws[12], vals, vecs,
+                                       inv, ws[0]) and not _repeated(vals, n):
+        c_status[s] = OK
+        return OK, s
     c_status[s] = _lapack_vectors(ops[0], vals, vecs, inv)
     return c_status[s], s
