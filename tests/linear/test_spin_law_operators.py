@@ -85,7 +85,8 @@ def test_damped_critical_thrust_equals_the_linearization_at_every_load(name, mon
 
 def test_the_command_line_and_a_compiled_process_give_the_same_undamped_onset():
     """A fresh ``impstab critical`` runs its kernels as Python (LAPACK's decompositions); a study
-    or any long work compiles them: both must reach the same onset (they were 9.6e-6 apart)."""
+    or any long work compiles them: both must reach the same onset (with the compiled
+    decompositions of a repeated eigenvalue they were 9.6e-6 apart)."""
     import json
     import os
     import subprocess
