@@ -14,9 +14,9 @@ a time integration. The first phase compiles these independent sets side by side
 entry points (:func:`warm_ups`: ``critical_load`` on a generic family; ``linearize`` of a model;
 the nonlinear right-hand side at real and complex states; the fixed-step integrator on a linear
 oscillator), so that no case starts before they are in the cache (two processes each compiling
-the engine would do the same minute of work twice), and no two of them compile the same kernel. The second phase runs each
-command's cases in a process of their own, the heaviest first; they load the shared kernels
-and compile only their own.
+the engine would do the same minute of work twice), and no two of them compile the same kernel.
+The second phase runs each command's cases in a process of their own, the heaviest first; they
+load the shared kernels and compile only their own.
 
 The cases use the bundled ``examples/`` when run from a source tree, else two small models
 and a small study written here. A command that uses kernels gets a line in :func:`cases`;

@@ -1,7 +1,7 @@
-"""A propeller whose speed grows as sqrt(T): the engine's operators ``A0 + p A1 + sqrt(p / T_op) A2``.
+"""A propeller whose speed grows as sqrt(T): the engine's operators ``A0 + p A1 + Omega(p) A2``.
 
-With ``speed_law = "sqrt-thrust"`` the gyroscopic matrix is ``G(T) = sqrt(T / T_op) G_op`` and the
-family is not affine; its stiffness still is, so the engine forms the three operators once
+With ``speed_law = "sqrt-thrust"`` the gyroscopic matrix is ``G(T) = Omega(T) G_1`` (the speed
+``Omega(T) = Omega_op sqrt(T / T_op)``, ``G_1`` per unit speed) and the family is not affine; its stiffness still is, so the engine forms the three operators once
 (``problems._GyroscopicLawProvider``) instead of linearizing the model at every load. Independent
 answers:
 

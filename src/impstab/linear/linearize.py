@@ -312,35 +312,32 @@ class ModelFamily:
 
     def affine_parts(self):
         """``(M, D, G, K0, K1)`` when the family is exactly affine with constant G, else None."""
-        if self._affine is None:  # type: ignore[attr-defined]
+        if self._affine is None or self._speed_follows_thrust:  # type: ignore[attr-defined]
             return None
+        return self._affine_grown(self.packed.speed)
+
+    def gyroscopic_law_parts(self):
+        """``(M, D, G1, K0, K1, speed)`` when K is exactly affine in T and the propeller's speed
+        follows the thrust (``sqrt-thrust``): ``G(T) = speed(T) G1``, ``G1`` per unit speed and
+        ``speed`` the model's own law (:meth:`PackedModel.spins`, rad/s, vectorized); else None (a
+        constant speed is affine: :meth:`affine_parts`)."""
+        if self._affine is None or not self._speed_follows_thrust:  # type: ignore[attr-defined]
+            return None
+        return (*self._affine_grown(1.0), self.packed.spins)
+
+    @property
+    def _speed_follows_thrust(self) -> bool:
         pk = self.packed
-        if pk.speed_law == "sqrt-thrust" and pk.polar_inertia * pk.speed != 0.0:
-            return None
+        return pk.speed_law == "sqrt-thrust" and pk.polar_inertia * pk.speed != 0.0
+
+    def _affine_grown(self, speed: float):
+        """``(M, D, G, K0, K1)`` of the affine form with G at propeller speed ``speed`` (rad/s), on
+        the grown dofs where the model has massive beam mounts."""
         m, d, k0, k1, g1 = self._affine  # type: ignore[attr-defined]
-        g = g1 * pk.polar_inertia * pk.speed
+        g = g1 * self.packed.polar_inertia * speed
         if self.internal is not None:
             (m, d, g, k0), k1 = self._grow(m, d, g, k0), self._grow_load(k1)
         return m, d, g, k0, k1
-
-    def gyroscopic_law_parts(self):
-        """``(M, D, G1, K0, K1, law)`` when K is exactly affine in T and the gyroscopic matrix follows
-        the propeller's ``sqrt-thrust`` speed law, ``G(T) = law(T) G1``: ``G1`` at the operating
-        speed, ``law(T) = sqrt(max(T, 0) / operating)`` (vectorized); else None (a constant speed
-        is affine: :meth:`affine_parts`)."""
-        pk = self.packed
-        if self._affine is None or pk.speed_law != "sqrt-thrust" or pk.polar_inertia * pk.speed == 0.0:  # type: ignore[attr-defined]
-            return None
-        m, d, k0, k1, g1 = self._affine  # type: ignore[attr-defined]
-        g = g1 * pk.polar_inertia * pk.speed
-        if self.internal is not None:
-            (m, d, g, k0), k1 = self._grow(m, d, g, k0), self._grow_load(k1)
-        operating = float(pk.operating)
-
-        def law(thrusts: Array) -> Array:
-            return np.sqrt(np.maximum(np.asarray(thrusts, dtype=float), 0.0) / operating)
-
-        return m, d, g, k0, k1, law
 
     def _grow(self, m, d, g, k, rotations=None):
         stack = lambda a: np.asarray(a, dtype=float)[None]  # noqa: E731

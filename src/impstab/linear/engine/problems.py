@@ -148,6 +148,15 @@ def mass_solve(m: Array, rhs: Array) -> Array:
     return out
 
 
+def _static_fold_indicator(m: Array, k: Array) -> float:
+    """The square of the smallest eigenvalue magnitude of ``M^-1 K`` (NaN where ``K`` is not finite:
+    no static equilibrium): linear in the load at a fold of the static path."""
+    if not np.isfinite(k).all():
+        return np.nan
+    s = np.linalg.eigvals(np.linalg.solve(m, k))
+    return float(np.min(np.abs(s)) ** 2)
+
+
 class _SecondOrderProvider:
     """Operators of a second-order family that is not affine (``family.matrices`` per load)."""
 
@@ -182,15 +191,13 @@ class _SecondOrderProvider:
 
     def fold_indicator(self, p: float) -> float:
         m, _, _, k = self.family.matrices(np.array([p]))
-        if not np.isfinite(k).all():
-            return np.nan
-        s = np.linalg.eigvals(np.linalg.solve(m[0], k[0]))
-        return float(np.min(np.abs(s)) ** 2)
+        return _static_fold_indicator(m[0], k[0])
 
 
 class _GyroscopicLawProvider:
     """Operators of an affine second-order family whose gyroscopic matrix follows a scalar law of
-    the load, ``G(p) = law(p) G1`` (a propeller whose speed grows as the square root of the thrust).
+    the load, ``G(p) = law(p) G1`` (a propeller whose speed grows as the square root of the thrust:
+    ``law`` its speed, ``G1`` per unit speed).
 
     ``A(p) = A0 + p A1 + law(p) A2`` with ``A0 = [[0, I], [-M^-1 K0, -M^-1 D]]``,
     ``A1 = [[0, 0], [-M^-1 K1, 0]]`` and ``A2 = [[0, 0], [0, -M^-1 G1]]``, formed once: a load then
@@ -221,8 +228,7 @@ class _GyroscopicLawProvider:
 
     def fold_indicator(self, p: float) -> float:
         k0, k1 = self._k
-        s = np.linalg.eigvals(np.linalg.solve(self._mass, k0 + p * k1))
-        return float(np.min(np.abs(s)) ** 2)
+        return _static_fold_indicator(self._mass, k0 + p * k1)
 
 
 class _FirstOrderProvider:
