@@ -43,7 +43,10 @@ def test_select_matches_a_stable_sort_of_the_shares(n, k, ties):
         share, order, clear = _reference(vecs, vc, wc, k)
         sel = np.full(n, -1, dtype=np.int64)
         got_share = np.empty(n)
-        got = select(vecs, vc, wc, np.int64(k), sel, got_share, np.empty(n, dtype=complex))
+        # distinct eigenvalues: no repeated eigenspace to turn (tests/linear/test_repeated_eigenspace.py)
+        vals = (1.0 + 1.0j) * np.arange(1, n + 1)
+        got = select(vals, vecs, np.zeros((n, n), complex), vc, wc, np.int64(k), sel, got_share,
+                     np.empty((3, n), dtype=complex))
         np.testing.assert_allclose(got_share, share, rtol=1e-12, atol=1e-14)
         picked = share[sel[:k]]
         # the same shares as the sort's first k, in decreasing order; the same columns where the

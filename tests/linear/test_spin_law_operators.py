@@ -12,10 +12,10 @@ answers:
   the thrust: extrapolated to zero from LAPACK's eigenvalues at 15000.20 N and 15000.25 N, that
   gives the onset independently of the engine (15000.16178 N; the curvature of the branch leaves
   about 4e-9 N).
-  The engine's exact indicator lands on it to 3e-13 with compiled kernels (which decompose a
-  whole operator with a repeated eigenvalue by LAPACK: with the compiled inverse iteration's
-  basis of the doubled pair that merges, the selection of the merging modes failed, and bisection
-  on the stability tolerance left the onset 1e-5 high, with a warning);
+  The engine's exact indicator lands on it to 3e-13 with compiled kernels (whose inverse
+  iteration returns another basis of the pair doubled at 15000 N than LAPACK: before the
+  selection turned that basis toward the cluster, bisection on the stability tolerance left the
+  onset 1e-5 high, with a warning);
 * the damped critical thrusts equal those through the linearization at every load to 1e-12.
 """
 
@@ -86,7 +86,8 @@ def test_damped_critical_thrust_equals_the_linearization_at_every_load(name, mon
 def test_the_command_line_and_a_compiled_process_give_the_same_undamped_onset():
     """A fresh ``impstab critical`` runs its kernels as Python (LAPACK's decompositions); a study
     or any long work compiles them: both must reach the same onset (with the compiled
-    decompositions of a repeated eigenvalue they were 9.6e-6 apart)."""
+    decompositions of a repeated eigenvalue, before the selection turned their basis toward the
+    cluster, they were 9.6e-6 apart)."""
     import json
     import os
     import subprocess

@@ -43,7 +43,7 @@ from .layout import (AFFINE, BISECTIONS, BRACKETS, DECOMPOSITIONS, DIRECTION, EV
 from .scan import _classify
 from .spectra import (DECOMPOSITION, FAILED, NOT_FINITE, OK, PROVIDER_ERROR, VALUES, cache_new, provided_weights,
                       spectrum, workspace)
-from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_COPIES, TOL_DUPLICATE, TOL_MARGINAL, TOL_UNSTABLE
+from .tolerances import EPS, FLOOR, TOL_CLUSTER, TOL_COPIES, TOL_DUPLICATE, TOL_MARGINAL, TOL_REPEATED, TOL_UNSTABLE
 
 __all__ = ["refine_stack"]
 
@@ -123,11 +123,12 @@ def projector(vecs, inv, members, vc, wc):
     return k
 
 
-def _select_numpy(vecs, vc, wc, k, sel, share, t):
+def _select_numpy(vals, vecs, inv, vc, wc, k, sel, share, work):
     """:func:`select` for interpreted runs: the same shares as two matrix products."""
     n = vecs.shape[0]
     proj = vc[:, :k] @ (wc[:k] @ vecs)
     share[:n] = (proj.real * proj.real + proj.imag * proj.imag).sum(axis=0)
+    align_repeated(vals, vecs, inv, vc, wc, k, share, work)
     order = np.argsort(-share[:n], kind="mergesort")
     sel[:k] = order[:k]
     return share[order[k - 1]] > 0.25 and (n == k or share[order[k]] < 0.25)
@@ -147,29 +148,143 @@ def _next_largest(share, n, sel, i):
     return best
 
 
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _projected(vc, wc, k, v, t):
+    """``t[:k] = W_C^H v`` (the cluster coordinates of the column ``v``)."""
+    n = v.shape[0]
+    for i in range(k):
+        s = 0j
+        for r in range(n):
+            s += wc[i, r] * v[r]
+        t[i] = s
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _share(vc, k, t):
+    """``|V_C t|^2`` (the share of a unit column whose cluster coordinates are ``t``)."""
+    total = 0.0
+    for r in range(vc.shape[0]):
+        y = 0j
+        for i in range(k):
+            y += vc[r, i] * t[i]
+        total += y.real * y.real + y.imag * y.imag
+    return total
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _coordinate(inv, row, vc, k, t):
+    """``w_row^H V_C t``: the component along column ``row`` of the decomposition of ``V_C t``."""
+    acc = 0j
+    for r in range(vc.shape[0]):
+        y = 0j
+        for i in range(k):
+            y += vc[r, i] * t[i]
+        acc += inv[row, r] * y
+    return acc
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def align_repeated(vals, vecs, inv, vc, wc, k, share, work):
+    """Turn the basis of each repeated eigenvalue's eigenspace toward the cluster, in place.
+
+    A repeated eigenvalue (two of ``vals`` within :data:`TOL_REPEATED` of the largest magnitude)
+    has no preferred eigenvectors: any basis of its eigenspace is one, and where the cluster holds
+    only one combination of them (a mode merging with one plane of a symmetric layout's doubled
+    pair) the shares of the two columns depend on the basis the decomposition returned. The
+    cluster's projector ``P = V_C W_C^H`` maps the eigenspace ``E`` (nearly) into itself; in the
+    columns' coordinates it is the 2 x 2 matrix ``M = W_E^H P V_E``, whose eigenvalues (near 1
+    and 0 where the cluster holds one combination) and eigenvectors ``x`` do not depend on the
+    basis: ``V_E -> V_E T`` takes ``M`` to ``T^-1 M T``. The two columns are replaced by the unit
+    vectors along ``V_E x`` (the one nearer the cluster first) and the two rows of ``inv`` by the
+    matching rows of the inverse, so that ``vecs`` and ``inv`` stay one decomposition, and their
+    shares are computed again. Left as they are: a pair that ``P`` does not split (eigenvalues
+    of ``M`` within 1e-3: all of ``E`` in the cluster, or none of it), a pair whose columns are
+    nearly parallel (cosine above 0.99995: a defective pair, not a semisimple one), and groups
+    of more than two. ``work (3, n)`` complex is work space.
+    """
+    n = vecs.shape[0]
+    scale = 0.0
+    for i in range(n):
+        scale = max(scale, abs(vals[i]))
+    t1, t2 = work[0], work[1]
+    for c1 in range(n):
+        c2 = -1
+        skip = False
+        for c in range(n):
+            if c != c1 and abs(vals[c] - vals[c1]) <= TOL_REPEATED * scale:
+                skip = skip or c2 >= 0 or c < c1
+                c2 = c
+        if c2 < 0 or skip:  # not repeated, a group of more than two, or a pair already turned
+            continue
+        beta = 0j
+        for r in range(n):
+            beta += vecs[r, c1].conjugate() * vecs[r, c2]
+        if not abs(beta) < 0.99995:
+            continue
+        _projected(vc, wc, k, vecs[:, c1], t1)
+        _projected(vc, wc, k, vecs[:, c2], t2)
+        m11, m12 = _coordinate(inv, c1, vc, k, t1), _coordinate(inv, c1, vc, k, t2)
+        m21, m22 = _coordinate(inv, c2, vc, k, t1), _coordinate(inv, c2, vc, k, t2)
+        half = 0.5 * (m11 + m22)
+        root = np.sqrt(half * half - (m11 * m22 - m12 * m21))
+        if root.real < 0.0:
+            root = -root
+        if not abs(root) > 0.5e-3:
+            continue
+        # eigenvectors of M for mu = half +- root: (m12, mu - m11) or (mu - m22, m21), the larger
+        mu1, mu2 = half + root, half - root
+        p1, q1 = m12, mu1 - m11
+        if abs(mu1 - m22) + abs(m21) > abs(p1) + abs(q1):
+            p1, q1 = mu1 - m22, m21
+        p2, q2 = m12, mu2 - m11
+        if abs(mu2 - m22) + abs(m21) > abs(p2) + abs(q2):
+            p2, q2 = mu2 - m22, m21
+        # the new columns y_i = p_i v1 + q_i v2, normalized
+        n1 = 0.0
+        n2 = 0.0
+        for r in range(n):
+            y1 = p1 * vecs[r, c1] + q1 * vecs[r, c2]
+            y2 = p2 * vecs[r, c1] + q2 * vecs[r, c2]
+            n1 += y1.real * y1.real + y1.imag * y1.imag
+            n2 += y2.real * y2.real + y2.imag * y2.imag
+        n1, n2 = sqrt(n1), sqrt(n2)
+        det = (p1 * q2 - p2 * q1) / (n1 * n2)
+        if not abs(det) > 1e-2:
+            continue
+        for r in range(n):
+            v1, v2 = vecs[r, c1], vecs[r, c2]
+            vecs[r, c1] = (p1 * v1 + q1 * v2) / n1
+            vecs[r, c2] = (p2 * v1 + q2 * v2) / n2
+        # rows: D X^-1 W_E^H with X = [[p1, p2], [q1, q2]], D = diag(n1, n2)
+        det = p1 * q2 - p2 * q1
+        for col in range(n):
+            w1, w2 = inv[c1, col], inv[c2, col]
+            inv[c1, col] = n1 * (q2 * w1 - p2 * w2) / det
+            inv[c2, col] = n2 * (-q1 * w1 + p1 * w2) / det
+        _projected(vc, wc, k, vecs[:, c1], t1)
+        share[c1] = _share(vc, k, t1)
+        _projected(vc, wc, k, vecs[:, c2], t2)
+        share[c2] = _share(vc, k, t2)
+
+
 @njit(cache=True, error_model="numpy", interpreted=_select_numpy, _nrt=False)
-def select(vecs, vc, wc, k, sel, share, t):
+def select(vals, vecs, inv, vc, wc, k, sel, share, work):
     """The ``k`` eigenvectors lying most in the cluster subspace into ``sel[:k]``; whether clear.
 
     ``vecs`` are unit columns; the share of each is the squared norm of its oblique projection
     onto the cluster subspace; clear when the ``k``-th share exceeds 1/4 and the next is below.
-    ``share (n,)`` receives the shares, ``t (k,)`` complex is work space. The ``k`` columns are
-    picked one by one (the cluster is small), in the order of a stable sort by decreasing share.
+    The basis of a repeated eigenvalue's eigenspace is first turned toward the cluster
+    (:func:`align_repeated`, which rewrites those columns of ``vecs`` and rows of ``inv``), so
+    that the choice does not depend on the basis the decomposition returned. ``share (n,)``
+    receives the shares, ``work (3, n)`` complex is work space. The ``k`` columns are picked one
+    by one (the cluster is small), in the order of a stable sort by decreasing share.
     """
     n = vecs.shape[0]
+    t = work[0]
     for c in range(n):
-        for i in range(k):
-            s = 0j
-            for r in range(n):
-                s += wc[i, r] * vecs[r, c]
-            t[i] = s
-        total = 0.0
-        for r in range(n):
-            y = 0j
-            for i in range(k):
-                y += vc[r, i] * t[i]
-            total += y.real * y.real + y.imag * y.imag
-        share[c] = total
+        _projected(vc, wc, k, vecs[:, c], t)
+        share[c] = _share(vc, k, t)
+    align_repeated(vals, vecs, inv, vc, wc, k, share, work)
     for i in range(k):
         sel[i] = _next_largest(share, n, sel, i)
     if not share[sel[k - 1]] > 0.25:
@@ -218,7 +333,7 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
     ``+-a + i b``, and like the undamped ``Delta`` analytic through the defective double root.
     ``work (3, n)`` complex is work space.
     """
-    if not select(vecs, vc, wc, k, sel, share, work[0]):
+    if not select(vals, vecs, inv, vc, wc, k, sel, share, work):
         return 0.0, 0.0, False
     v, b = work[1], work[2]
     for i in range(k):
@@ -575,7 +690,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                     if code_a == PROVIDER_ERROR:
                         failed = True
                         break
-                    ok_a = code_a != NOT_FINITE and select(c_vecs[sa], vc, wc, k, sel, share, work[0])
+                    ok_a = code_a != NOT_FINITE and select(c_vals[sa], c_vecs[sa], c_inv[sa], vc, wc, k, sel, share, work)
                     while unique and ok_a:  # the exact route (a loop only to leave it early)
                         target = 0.0
                         coalesce = False
@@ -590,7 +705,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                                 if code == PROVIDER_ERROR:
                                     failed = True
                                     break
-                                if code == NOT_FINITE or not select(c_vecs[s], vc, wc, k, sel, share, work[0]):
+                                if code == NOT_FINITE or not select(c_vals[s], c_vecs[s], c_inv[s], vc, wc, k, sel, share, work):
                                     marginal = False
                                     break
                                 for i in range(k):
@@ -685,7 +800,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                         if code == PROVIDER_ERROR:
                             failed = True
                             break
-                        select(c_vecs[s], vc, wc, k, sel, share, work[0])
+                        select(c_vals[s], c_vecs[s], c_inv[s], vc, wc, k, sel, share, work)
                         for i in range(k):  # loops, not slice assignments (see scan_stack)
                             cols[i] = sel[i]
                         shapes, values = _take(c_vals[s], c_vecs[s], cols, k, n_dof)
@@ -696,7 +811,7 @@ def refine_stack(jobs, onsets, mode_out, part_out, counts):
                             if code == PROVIDER_ERROR:
                                 failed = True
                                 break
-                            if code != NOT_FINITE and select(c_vecs[s], vc, wc, k, sel, share, work[0]):
+                            if code != NOT_FINITE and select(c_vals[s], c_vecs[s], c_inv[s], vc, wc, k, sel, share, work):
                                 shapes, values = _take(c_vals[s], c_vecs[s], sel, k, n_dof)
                         break
                     if step_back:

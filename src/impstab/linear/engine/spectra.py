@@ -15,16 +15,11 @@ Where it comes from:
 Eigenvalues and eigen-decompositions come from the compiled small-matrix routines
 (:mod:`impstab.linear.small_eig`, :mod:`impstab.linear.small_eigvec`) up to order
 :data:`~impstab.linear.small_eig.MAX_ORDER`; larger operators, and any that the compiled
-routines cannot resolve (no convergence, a defective block), go to LAPACK through NumPy. So does
-the decomposition of a whole operator (a provider's, or an affine one whose blocks failed) with a
-repeated eigenvalue: its vectors are then one basis of the eigenspace among many, and where only
-one combination of it merges with another mode the refinement's selection of the merging modes,
-by each vector's share in the cluster's subspace, depends on the basis. LAPACK's is the one a
-process gets while its kernels run as Python (the conservative companion of
-``examples/imp_isolation.toml``, whose doubled pair merges with a mode: shares of 0.94 and 0.64
-with the compiled inverse iteration's basis, 0.99 and 0.064 with LAPACK's; the exact route refused
-the first, and a study put the onset 1e-5 away from the command line's). The block route of affine
-problems puts a symmetric layout's copies in blocks of their own.
+routines cannot resolve (no convergence, a defective block), go to LAPACK through NumPy. A
+repeated eigenvalue's vectors are one basis of its eigenspace among many, and the compiled
+routines and LAPACK return different ones; the refinement turns that basis toward the cluster it
+follows before it uses it (:func:`impstab.linear.engine.refine.align_repeated`), so no result
+depends on which routine decomposed the operator.
 
 :func:`spectrum` is the one entry point of the scan and the refinement (numba links a
 function's callees into it and optimises them again, so the engine keeps a single function
@@ -206,23 +201,6 @@ def _values_of(op, ws, out):
     _lapack_values(op, out)
 
 
-#: eigenvalues closer than this (relative to the largest magnitude) count as one repeated eigenvalue
-REPEATED = 1e-8
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _repeated(vals, n):
-    """Whether two of ``vals[:n]`` are equal to :data:`REPEATED` of the largest magnitude."""
-    scale = 0.0
-    for i in range(n):
-        scale = max(scale, abs(vals[i]))
-    for i in range(n):
-        for k in range(i):
-            if abs(vals[i] - vals[k]) <= REPEATED * scale:
-                return True
-    return False
-
-
 #: the ``vectors`` argument of :func:`spectrum`. NumPy booleans, not ``False`` and ``True``: numba
 #: compiles a compiled callee once more for each literal constant it is passed (``Literal[bool]``),
 #: but once for a NumPy boolean of either value
@@ -300,11 +278,9 @@ def spectrum(jobs, j, loads, vectors, cache, ws, ev):
         vals[:] = np.nan
         return NOT_FINITE, s
     # the one design of ws[6..9] as an int64, as ``j`` above: numba compiles a callee once per
-    # argument type, and a literal 0 is a type of its own (``Literal[int](0)``). A repeated
-    # eigenvalue's vectors are one basis of its eigenspace among many: those go to LAPACK, the
-    # basis a process gets while its kernels run as Python (see the module's docstring)
+    # argument type, and a literal 0 is a type of its own (``Literal[int](0)``)
     if n <= MAX_ORDER and block_eig_at(ops[:1], ws[6], np.int64(0), 0.0, ws[7], ws[8], ws[9], ws[12], vals, vecs,
-                                       inv, ws[0]) and not _repeated(vals, n):
+                                       inv, ws[0]):
         c_status[s] = OK
         return OK, s
     c_status[s] = _lapack_vectors(ops[0], vals, vecs, inv)

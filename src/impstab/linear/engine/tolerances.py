@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TOL_UNSTABLE", "TOL_MARGINAL", "FLOOR", "TOL_CLUSTER", "TOL_DUPLICATE", "TOL_COPIES", "EPS"]
+__all__ = ["TOL_UNSTABLE", "TOL_MARGINAL", "FLOOR", "TOL_CLUSTER", "TOL_DUPLICATE", "TOL_COPIES", "TOL_REPEATED", "EPS"]
 
 #: relative size of an imaginary part (of s) or a real part (of lambda) that counts as unstable
 TOL_UNSTABLE = 1e-7
@@ -23,5 +23,8 @@ TOL_DUPLICATE = 1e-9
 #: relative spread within which the upper half of a first-order cluster of more than one pair is
 #: copies of one eigenvalue (identical planes), refined by Newton on their mean growth
 TOL_COPIES = 1e-9
+#: relative distance (to the largest magnitude) within which two eigenvalues of one decomposition
+#: are one repeated eigenvalue, whose eigenvectors are one basis of its eigenspace among many
+TOL_REPEATED = 1e-8
 #: machine epsilon of float64
 EPS = float(np.finfo(float).eps)
