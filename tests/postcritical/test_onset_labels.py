@@ -14,7 +14,8 @@ independent answers.
   just past T_c settles on the small stable cycle of the computed branch (supercritical);
 * the softening example with dampers ten times lighter: l1 < 0 (the critical mode changes), and a
   run from a small displacement past T_c settles on the small cycle, not on the snubber cycle of
-  the same branch; with its own dampers l1 > 0 and the run jumps to the snubber cycle;
+  the same branch (with its own dampers l1 > 0 and the run jumps to the snubber cycle:
+  test_propulsor.py);
 * snubbers engaged at the equilibrium: the same l1 on circles of 1 to 30 state scales;
 * a model whose mounts have rotational (6 x 6) stiffness, rotated at equilibrium: l1 does not
   depend on the circle (the logarithm of the rotation is continued analytically, not clamped).
@@ -27,6 +28,7 @@ import numpy as np
 import pytest
 
 import impstab
+from _settled import settled_amplitude
 from impstab.model import model_from_dict
 from impstab.postcritical import hopf_analysis, propulsor_postcritical
 from impstab.postcritical.propulsor import propulsor_system
@@ -147,18 +149,6 @@ def test_rotational_mount_stiffness_l1_does_not_depend_on_the_circle():
     assert np.ptp(l1) < 1e-6 * abs(l1[0]) and max(h.lyapunov_error for h in hs) < 1e-4 * abs(l1[0])
 
 
-def _settled_amplitude(model, thrust, tc, duration, dt):
-    """Amplitudes (half peak-to-peak) of the six coordinates after ``duration`` s of a Hamming run
-    from a small pitch displacement, over 0.5 s sampled at 1e-4 s from the state reached."""
-    settle = impstab.simulate(model, thrust=thrust, duration=duration, dt=dt, integrator="hamming",
-                              critical_thrust=tc, sample=0.5, perturbation={"displacement": {"pitch": 0.001}})
-    z = settle.deviation[-1]
-    run = impstab.simulate(model, thrust=thrust, duration=0.5, dt=dt, integrator="hamming", critical_thrust=tc,
-                           sample=1e-4, perturbation={"displacement": z[:6], "velocity": z[6:]})
-    y = run.deviation + run.equilibrium
-    return 0.5 * (y[:, :6].max(axis=0) - y[:, :6].min(axis=0))
-
-
 def _softening(c_axial, c_shear):
     d = _toml("imp_softening.toml")
     for mount in d["mounts"]:
@@ -177,17 +167,8 @@ def test_light_damping_makes_the_softening_onset_supercritical_and_a_run_stays_o
     idx = [k for k, t in enumerate(res.branch_thrust) if t == tc + 50.0]
     small = min(idx, key=lambda k: res.branch_amplitude[k, 4])
     assert res.branch_stable[small] and not res.snubber_contact[small] and len(idx) >= 2
-    amplitude = _settled_amplitude(model, tc + 50.0, tc, 1500.0, 8e-4)
+    amplitude = settled_amplitude(model, tc + 50.0, tc, 1500.0, 8e-4)
     np.testing.assert_allclose(amplitude, res.branch_amplitude[small], rtol=1e-4)
-
-
-def test_past_the_subcritical_softening_onset_a_run_jumps_to_the_snubber_cycle():
-    model, tc, res = _softening(40.0, 8.0)
-    assert res.bifurcation == "subcritical"
-    (i,) = [k for k, t in enumerate(res.branch_thrust) if t == tc + 50.0]
-    assert res.branch_stable[i] and res.snubber_contact[i] and res.branch_amplitude[i, 4] > 0.04
-    amplitude = _settled_amplitude(model, tc + 50.0, tc, 3000.0, 5e-4)       # from 0.001 rad of pitch
-    np.testing.assert_allclose(amplitude, res.branch_amplitude[i], rtol=1e-3)
 
 
 def test_snubbers_engaged_at_equilibrium_give_the_same_l1_on_every_circle():

@@ -13,6 +13,9 @@
   hardening gives a supercritical onset, softening a subcritical one;
 * the degenerate onsets say so with the reason, never with a coefficient: an undamped model (a
   1:1 resonance), a symmetric ring (a double pair), a divergence;
+* the softening example (subcritical): between its fold and T_c the branch has two cycles, the
+  small one unstable and the large one stable; 50 N past T_c a long Hamming run from a small
+  displacement jumps to the large cycle that the snubbers bound;
 * every requested thrust appears exactly in the branch; JSON keys of DESIGN.md; bad input.
 """
 
@@ -24,6 +27,7 @@ import pytest
 import xarray as xr
 
 import impstab
+from _settled import settled_amplitude
 from impstab.cli import main
 from impstab.errors import ModelError
 from impstab.model import model_from_dict
@@ -203,26 +207,41 @@ def test_no_onset_up_to_thrust_max(examples_dir):
 
 
 # ------------------------------------------------------------------ subcritical: the dangerous example
+#: between the softening example's fold (292 N below its onset) and the onset
+BELOW = 150.0
+
+
 @pytest.fixture(scope="module")
 def dangerous(examples_dir):
+    """The softening example's branch, through a thrust between its fold and T_c and one past T_c."""
     model = impstab.load_model(examples_dir / "imp_softening.toml")
-    return model, propulsor_postcritical(model)
+    tc = impstab.critical_thrust(model).thrust
+    return model, tc, propulsor_postcritical(model, thrusts=[tc - BELOW, tc + 50.0])
 
 
 def test_the_softening_design_is_subcritical_with_a_fold_below_the_onset(dangerous):
-    model, res = dangerous
+    model, tc, res = dangerous
     assert res.bifurcation == "subcritical" and res.lyapunov_coefficient > 0
     assert res.fold_thrust is not None and res.fold_thrust < res.critical_thrust
     assert res.practical_limit_thrust == res.fold_thrust
     assert res.reading.startswith("dangerous")
     assert np.any(res.snubber_contact)                        # the snubber is what stops the growth
     # just below the onset, between the fold and T_c, two cycles: the small unstable one and the large stable one
-    t = 0.5 * (res.fold_thrust + res.critical_thrust)
-    again = propulsor_postcritical(model, thrusts=[t])
-    idx = _cycle(again, t)
+    assert res.fold_thrust < tc - BELOW
+    idx = _cycle(res, tc - BELOW)
     assert len(idx) == 2
-    small, large = sorted(idx, key=lambda i: again.branch_amplitude[i, 4])
-    assert not again.branch_stable[small] and again.branch_stable[large]
+    small, large = sorted(idx, key=lambda i: res.branch_amplitude[i, 4])
+    assert not res.branch_stable[small] and res.branch_stable[large]
+
+
+def test_past_the_subcritical_onset_a_run_jumps_to_the_snubber_cycle(dangerous):
+    # from 0.001 rad of pitch, 50 N past the onset, a long run grows onto the large stable cycle
+    # that the snubbers bound, the only stable cycle the branch has there
+    model, tc, res = dangerous
+    (i,) = _cycle(res, tc + 50.0)
+    assert res.branch_stable[i] and res.snubber_contact[i] and res.branch_amplitude[i, 4] > 0.04
+    amplitude = settled_amplitude(model, tc + 50.0, tc, 3000.0, 5e-4)
+    np.testing.assert_allclose(amplitude, res.branch_amplitude[i], rtol=1e-3)
 
 
 # ------------------------------------------------------------------ outputs and the command line
