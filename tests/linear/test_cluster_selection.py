@@ -1,4 +1,4 @@
-"""The refinement's choice of the cluster's eigenvectors (``impstab.linear.engine.refine.select``).
+"""The refinement's choice of the cluster's eigenvectors (``impstab.linear.engine.cluster.select``).
 
 The compiled routine picks the ``k`` columns with the largest share one by one; the reference here
 is NumPy's stable sort of the same shares, computed here as two matrix products. Ties (identical
@@ -35,7 +35,7 @@ def _case(rng, n, k, ties):
 @pytest.mark.parametrize("n,k", [(2, 1), (2, 2), (4, 2), (6, 2), (6, 4), (12, 4), (12, 12)])
 def test_select_matches_a_stable_sort_of_the_shares(n, k, ties):
     require_compiled()
-    from impstab.linear.engine.refine import select
+    from impstab.linear.engine.cluster import select
 
     rng = np.random.default_rng(10 * n + k + ties)
     for _ in range(20):
@@ -60,7 +60,7 @@ def test_select_matches_a_stable_sort_of_the_shares(n, k, ties):
 
 def test_select_takes_exact_ties_in_column_order_and_nan_last():
     require_compiled()
-    from impstab.linear.engine.refine import _next_largest
+    from impstab.linear.engine.cluster import _next_largest
 
     share = np.array([0.5, np.nan, 0.9, 0.5, 0.9, np.nan, 0.1])
     sel = np.full(len(share), -1, dtype=np.int64)

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from impstab._jit import require_compiled
-from impstab.linear.engine import refine
+from impstab.linear.engine import cluster
 
 N = 8
 THETA = 0.7  # the cluster's combination of the doubled pair: cos(THETA) v0 + sin(THETA) v1
@@ -63,7 +63,7 @@ def _raw_shares(vecs, vc, wc):
 def test_the_selection_does_not_depend_on_the_basis_of_a_doubled_eigenspace(way):
     if way == "compiled":
         require_compiled()
-    select = refine._select_numpy if way == "interpreted" else refine.select
+    select = cluster._select_numpy if way == "interpreted" else cluster.select
     a, lam, v, g, vc, wc = _problem()
     ambiguous = 0
     for mixing in _mixings():
@@ -89,12 +89,12 @@ def test_nearly_parallel_or_distinct_columns_are_left_alone():
     lam2[1] += 1e-6
     vals, vecs, inv = _decomposition(lam2, v, np.array([[1.0, 1.0], [1.0, -1.0]]))
     before = vecs.copy()
-    refine.align_repeated(vals, vecs, inv, vc, wc, 2, np.zeros(N), np.zeros((3, N), complex))
+    cluster.align_repeated(vals, vecs, inv, vc, wc, 2, np.zeros(N), np.zeros((3, N), complex))
     np.testing.assert_array_equal(vecs, before)
     # a defective-looking pair (columns at a cosine of 1 - 1e-10): nothing turned either
     vals, vecs, inv = _decomposition(lam, v, np.eye(2))
     vecs[:, 1] = vecs[:, 0] + 1e-5 * vecs[:, 1]
     vecs[:, 1] /= np.linalg.norm(vecs[:, 1])
     before = vecs.copy()
-    refine.align_repeated(vals, vecs, inv, vc, wc, 2, np.zeros(N), np.zeros((3, N), complex))
+    cluster.align_repeated(vals, vecs, inv, vc, wc, 2, np.zeros(N), np.zeros((3, N), complex))
     np.testing.assert_array_equal(vecs, before)

@@ -8,6 +8,9 @@ One implementation serves a single model (a stack of one), the generic
 * :mod:`~impstab.linear.engine.spectra` -- its eigenvalues and decompositions at a load
   (decoupled blocks, compiled small-matrix routines, LAPACK for large operators);
 * :mod:`~impstab.linear.engine.scan` -- the scan with the bubble searches;
+* :mod:`~impstab.linear.engine.cluster` -- the cluster going unstable, followed across a bracket by
+  its spectral projector, and its exact indicator;
+* :mod:`~impstab.linear.engine.roots` -- root finding as steps (Newton on exact derivatives, Brent);
 * :mod:`~impstab.linear.engine.refine` -- the exact refinement of each bracket and the onset values;
 * :mod:`~impstab.linear.engine.solve` -- the Python entry point and its outcomes.
 """

@@ -214,7 +214,7 @@ def full_onset(problem, reduced_load: float, kind: str, omega: float, w: Array, 
 
     Returns ``((load, kind, omega, mode, participation), "")`` on success.
     """
-    from .refine import newton_step
+    from .roots import newton_step
 
     pencil = _Pencil(problem)
     divergence = kind == "divergence"

@@ -18,7 +18,7 @@ Eigenvalues and eigen-decompositions come from the compiled small-matrix routine
 routines cannot resolve (no convergence, a defective block), go to LAPACK through NumPy. A
 repeated eigenvalue's vectors are one basis of its eigenspace among many, and the compiled
 routines and LAPACK return different ones; the refinement turns that basis toward the cluster it
-follows before it uses it (:func:`impstab.linear.engine.refine.align_repeated`), so no result
+follows before it uses it (:func:`impstab.linear.engine.cluster.align_repeated`), so no result
 depends on which routine decomposed the operator.
 
 :func:`spectrum` is the one entry point of the scan and the refinement (numba links a
