@@ -7,7 +7,7 @@ the argument types the commands give it and stores it in the cache of
 A later ``impstab critical`` or ``impstab simulate`` loads the machine code instead of compiling
 it for minutes.
 
-Two phases, each spread over ``--jobs`` processes (default the cores available, at most 4).
+Two phases, spread over the same ``--jobs`` processes (default the cores available, at most 4).
 Every command computes a critical thrust first, so every case needs the kernels of the stability
 engine, and most need the tangent stiffness at the static equilibrium, the right-hand side and
 a time integration. The first phase compiles these independent sets side by side through public
@@ -15,8 +15,8 @@ entry points (:func:`warm_ups`: ``critical_load`` on a generic family; ``lineari
 the nonlinear right-hand side at real and complex states; the fixed-step integrator on a linear
 oscillator), so that no case starts before they are in the cache (two processes each compiling
 the engine would do the same minute of work twice), and no two of them compile the same kernel.
-The second phase runs each command's cases in a process of their own, the heaviest first; they
-load the shared kernels and compile only their own.
+The second phase runs each command's cases in one of those processes, the heaviest first; they
+load the shared kernels (or have them already) and compile only their own.
 
 The cases use the bundled ``examples/`` when run from a source tree, else two small models
 and a small study written here. A command that uses kernels gets a line in :func:`cases`;
@@ -345,11 +345,12 @@ def main(argv: list[str] | None = None) -> int:
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor
 
-            # the kernels every command shares, side by side; then one command per process
-            with ProcessPoolExecutor(min(jobs, len(first)), mp_context=multiprocessing.get_context("spawn")) as pool:
+            # the kernels every command shares, side by side; once all are in the cache, one command
+            # per process, in the same processes (a fresh one costs its imports and numba's start again)
+            workers = min(jobs, max(len(first), len(groups)))
+            with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
                 for result in pool.map(_warm, *zip(*first), [args.quiet] * len(first)):
                     failed += result
-            with ProcessPoolExecutor(min(jobs, len(groups)), mp_context=multiprocessing.get_context("spawn")) as pool:
                 for result in pool.map(_run, groups, [total] * len(groups), [args.quiet] * len(groups)):
                     failed += result
         else:
