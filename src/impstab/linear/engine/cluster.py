@@ -279,6 +279,32 @@ def select(vals, vecs, inv, vc, wc, k, sel, share, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
+def _upper_half(v, k):
+    """Whether some of ``v[:k]`` lie in the upper half plane (the cluster's sums then count those)."""
+    upper = False
+    for i in range(k):
+        upper = upper or v[i].imag > 0
+    return upper
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _sums(v, b, k, upper):
+    """``(sum v, sum b, sum v b, m)`` over the ``m`` members of ``v[:k]`` counted: all of them, or
+    with ``upper`` those with ``Im v >= 0``."""
+    s1 = 0j
+    sb = 0j
+    svb = 0j
+    m = 0
+    for i in range(k):
+        if not upper or v[i].imag >= 0:
+            s1 += v[i]
+            sb += b[i]
+            svb += v[i] * b[i]
+            m += 1
+    return s1, sb, svb, m
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _pair_growth(v, k):
     """Largest real part of a cluster (upper half plane), from its symmetric functions.
 
@@ -286,15 +312,8 @@ def _pair_growth(v, k):
     ``d = mean((lambda - c)^2)`` are analytic in the load even where the pair is defective, so
     ``Re c + |Re sqrt(d)|`` keeps its accuracy there; for a single eigenvalue it is ``Re lambda``.
     """
-    upper = False
-    for i in range(k):
-        upper = upper or v[i].imag > 0
-    c = 0j
-    m = 0
-    for i in range(k):
-        if not upper or v[i].imag >= 0:
-            c += v[i]
-            m += 1
+    upper = _upper_half(v, k)
+    c, _, _, m = _sums(v, v, k, upper)
     c /= m
     d = 0j
     for i in range(k):
@@ -324,19 +343,9 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
         v[i] = vals[sel[i]]
     jj = 0
     # the members counted: all, or with ``coalesce`` the upper half (where there is one)
-    upper = False
-    if coalesce:
-        for i in range(k):
-            upper = upper or v[i].imag > 0
+    upper = coalesce and _upper_half(v, k)
     if undamped or coalesce:
-        s1 = 0j
-        s2 = 0j
-        m = 0
-        for i in range(k):
-            if not upper or v[i].imag >= 0:
-                s1 += v[i]
-                s2 += v[i] * v[i]
-                m += 1
+        s1, _, s2, m = _sums(v, v, k, upper)
         f = s1.real / k if divergence else (m * s2 - s1 * s1).real
     else:
         best = -np.inf
@@ -366,17 +375,8 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
         # a larger cluster: copies of one pair (identical planes of a symmetric layout) have the
         # derivative of their mean, the trace of the upper half's block of W_C A1 V_C (invariant
         # under the choice of basis in the repeated eigenspace); anything else: none (NaN)
-        upper = False
-        for i in range(k):
-            upper = upper or v[i].imag > 0
-        c = 0j
-        cb = 0j
-        m = 0
-        for i in range(k):
-            if not upper or v[i].imag >= 0:
-                c += v[i]
-                cb += b[i]
-                m += 1
+        upper = _upper_half(v, k)
+        c, cb, _, m = _sums(v, b, k, upper)
         c /= m
         for i in range(k):
             if (not upper or v[i].imag >= 0) and abs(v[i] - c) > TOL_COPIES * abs(c):
@@ -387,14 +387,5 @@ def indicator(vals, vecs, inv, a1, undamped, vc, wc, k, divergence, target, deri
         for i in range(k):
             df += b[i].real
         return f, df / k, True
-    s1 = 0j
-    sb = 0j
-    svb = 0j
-    m = 0
-    for i in range(k):
-        if not upper or v[i].imag >= 0:
-            s1 += v[i]
-            sb += b[i]
-            svb += v[i] * b[i]
-            m += 1
+    s1, sb, svb, m = _sums(v, b, k, upper)
     return f, (2 * m * svb - 2 * s1 * sb).real, True
