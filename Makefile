@@ -40,11 +40,7 @@ $(STAMP): pyproject.toml
 	$(PY) -c "$$BYTECODE"
 	touch $(STAMP)
 
-# impstab's own modules, installed in place (editable), get their bytecode here, on every core:
-# where PYTHONDONTWRITEBYTECODE is set, each of the test run's 70-odd processes would otherwise
-# compile them from source (0.25 s of CPU each); up-to-date files are skipped
 compile: $(STAMP)
-	$(PY) -m compileall -q -j 0 src
 	MPLBACKEND=Agg $(PY) -m impstab.precompile
 
 demo: compile
