@@ -2,7 +2,8 @@
 #   make demo         create .venv if missing, install impstab, compile its kernels, run the bundled example
 #   make test         create/update the same .venv, compile the kernels, run the whole test suite (in parallel)
 #   make compile      compile the kernels the commands use (once; kept until their sources change)
-#   make clean-cache  remove the compiled kernels (make compile, or the first command, compiles them again)
+#   make clean-cache  remove the compiled kernels, shared by the clones on this machine (make compile, or the first
+#                     command, compiles them again)
 # The environment is installed by uv (itself installed by pip first; its resolver and parallel
 # downloads and unpacking take 5 s where pip takes 35 s), or by pip where uv cannot be installed.
 # pip installs without compiling to bytecode (on one core, half its time); then the environment's

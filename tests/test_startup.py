@@ -192,6 +192,58 @@ def test_numba_cache_folder_is_outside_the_sources_and_the_users_setting_wins(tm
     assert res.stdout.split() == [env_dir, env_dir]
 
 
+def test_two_clones_share_the_compiled_kernels_and_other_code_keeps_numbas_layout(tmp_path):
+    """A kernel compiled by one copy of the package is loaded, not compiled, by a copy at another
+    path (later time stamps: a fresh clone), from the same folder inside the shared cache; numba's
+    own layout stays for code outside the package."""
+    first, second = tmp_path / "clone-a" / "src", tmp_path / "clone-b" / "src"
+    _package_copy(first)
+    (second / "impstab").parent.mkdir(parents=True)
+    shutil.copytree(first / "impstab", second / "impstab")
+    os.utime(second / "impstab" / "kinematics" / "so3.py")  # newer than the first clone's
+    (tmp_path / "other.py").write_text("import numba\n\n@numba.njit(cache=True)\ndef twice(x):\n    return 2 * x\n")
+    code = ("import json, os, numpy as np, impstab._jit as jit, impstab._numba_cache as c; jit.require_compiled(); "
+            "from impstab.kinematics.so3 import _skew; import other; _skew(np.ones(3)); other.twice(1.0); "
+            "print(json.dumps([c.kernel_folder().as_posix(), sum(_skew.stats.cache_hits.values()), "
+            "sum(_skew.stats.cache_misses.values()), sum(other.twice.stats.cache_hits.values())]))")
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", _numba_cache.SET_BY_IMPSTAB)}
+    env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
+    out = []
+    for src in (first, second):
+        res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                             env={**env, "PYTHONPATH": os.pathsep.join([str(src), str(tmp_path)])})
+        assert res.returncode == 0, res.stderr
+        out.append(json.loads(res.stdout.splitlines()[-1]))
+    (folder_a, hits_a, misses_a, _), (folder_b, hits_b, misses_b, other_hits) = out
+    assert folder_a == folder_b and folder_a.startswith((tmp_path / "cache" / "impstab" / "numba").as_posix())
+    assert (hits_a, misses_a) == (0, 1) and (hits_b, misses_b) == (1, 0)
+    assert any((Path(folder_a) / "impstab" / "kinematics").glob("so3._skew-*.nbi"))
+    # the other module (one path) was cached beside impstab's kernels in numba's layout, and loaded
+    assert other_hits == 1 and not (Path(folder_a) / "other").exists()
+
+
+def test_prune_keeps_the_most_recently_compiled_sources(tmp_path, monkeypatch):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.delenv(_numba_cache.SET_BY_IMPSTAB, raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    current = _numba_cache.cache_dir()
+    assert current.parent == tmp_path / "impstab" / "numba"
+    (current / "env").mkdir(parents=True)
+    for k in range(5):  # key folders compiled 5 to 1 days ago; one never completed (its folder's time)
+        marker = current.parent / f"old{k}" / "env" / _numba_cache.MARKER
+        marker.parent.mkdir(parents=True)
+        marker.write_text("done\n")
+        os.utime(marker, (1e9 - 86400 * (5 - k),) * 2)
+    os.utime(current.parent / "old0", (1e9 + 1,) * 2)  # a recent folder, but its marker is the oldest
+    (current.parent / "partial" / "env").mkdir(parents=True)
+    os.utime(current.parent / "partial", (1e9 - 86400 * 10,) * 2)
+    removed = _numba_cache.prune(keep=3)
+    assert sorted(p.name for p in removed) == ["old0", "old1", "old2", "partial"]
+    assert sorted(p.name for p in current.parent.iterdir()) == sorted(["old3", "old4", current.name])
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "own"))  # the user's own folder: never pruned
+    assert _numba_cache.prune(keep=1) == [] and (current.parent / "old4").is_dir()
+
+
 # -- the precompile step ---------------------------------------------------------------------------
 @pytest.mark.parametrize("from_examples", [True, False])
 def test_precompile_cases_are_valid_command_lines(tmp_path, monkeypatch, from_examples):
@@ -235,8 +287,8 @@ def test_precompile_stops_at_a_complete_cache_and_keeps_the_users_own(tmp_path, 
     from impstab import precompile
 
     own = tmp_path / "own"
-    own.mkdir()
-    (own / precompile.MARKER).write_text("done\n")
+    (own / _numba_cache.versions_tag()).mkdir(parents=True)
+    (own / _numba_cache.versions_tag() / precompile.MARKER).write_text("done\n")
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(own))
     monkeypatch.delenv(_numba_cache.SET_BY_IMPSTAB, raising=False)
     # precompile sets IMPSTAB_JIT = compiled for its worker processes: restored after the test (the
@@ -245,7 +297,7 @@ def test_precompile_stops_at_a_complete_cache_and_keeps_the_users_own(tmp_path, 
     assert precompile.main(["--quiet"]) == 0
     assert "already compiled" in capsys.readouterr().out
     assert precompile.main(["--clean"]) == 0
-    assert "not removed" in capsys.readouterr().out and (own / precompile.MARKER).is_file()
+    assert "not removed" in capsys.readouterr().out and (own / _numba_cache.versions_tag() / precompile.MARKER).is_file()
 
 
 def test_concurrent_cache_saves_of_one_kernel_keep_every_signature(tmp_path, monkeypatch):

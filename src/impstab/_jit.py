@@ -193,9 +193,10 @@ def require_compiled(force: bool = False) -> None:
             return
         import numba
 
-        from ._numba_cache import lock_cache_files
+        from ._numba_cache import locate_by_package, lock_cache_files
 
         lock_cache_files()  # processes compiling into one cache at once (make compile, test workers)
+        locate_by_package()  # kernels cached by their place in the package: shared by every clone
         for hook in _hooks:
             hook()
         for kernel in _kernels:

@@ -3,7 +3,8 @@
 ``python -m impstab.precompile`` (run by ``make demo`` and ``make test`` after installing) runs
 each command on small cases through the command line, so that numba compiles each kernel with
 the argument types the commands give it and stores it in the cache of
-:mod:`impstab._numba_cache` (outside the source tree; kept until the kernels' sources change).
+:mod:`impstab._numba_cache` (outside the source tree, shared by every clone on the machine; kept until
+the kernels' sources change).
 A later ``impstab critical`` or ``impstab simulate`` loads the machine code instead of compiling
 it for minutes.
 
@@ -44,7 +45,7 @@ from . import _numba_cache
 __all__ = ["cases", "warm_ups", "main", "kernels", "MARKER"]
 
 #: written into the cache folder when every case ran
-MARKER = "precompiled.txt"
+MARKER = _numba_cache.MARKER
 
 #: the bundled examples when running from a source tree (src/impstab/precompile.py)
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -314,7 +315,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("-q", "--quiet", action="store_true", help="only the first and the summary line")
     parser.add_argument("--force", action="store_true", help="run the cases even if this cache is complete")
     parser.add_argument("--clean", action="store_true",
-                        help="remove impstab's compiled kernels (every cache folder of this environment) and stop")
+                        help="remove impstab's compiled kernels (every cache folder, shared by the clones on this machine) and stop")
     args = parser.parse_args(argv)
 
     from ._blas import prefer_single_thread
@@ -327,12 +328,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.clean:
         return _clean()
     _bytecode()
-    marker = _numba_cache.cache_dir() / MARKER
+    marker = _numba_cache.kernel_folder() / MARKER
     if marker.is_file() and not args.force:
         print(f"impstab: kernels already compiled in {marker.parent}")
         return 0
     jobs = args.jobs or min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
-    print(f"impstab: compiling kernels into {_numba_cache.cache_dir()} ({jobs} processes)", flush=True)
+    print(f"impstab: compiling kernels into {marker.parent} ({jobs} processes)", flush=True)
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="impstab-precompile-") as tmp:
         models = _models(Path(tmp))
@@ -364,6 +365,8 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     marker.parent.mkdir(parents=True, exist_ok=True)
     marker.write_text(f"{total} cases\n", encoding="utf-8")
+    for folder in _numba_cache.prune():
+        print(f"impstab: removed the kernels of older sources, {folder}")
     return 0
 
 
@@ -390,6 +393,10 @@ def _clean() -> int:
     folder = _numba_cache.cache_root() / "numba"
     shutil.rmtree(folder, ignore_errors=True)
     print(f"impstab: removed {folder}")
+    legacy = Path(sys.prefix) / "var" / "cache" / "impstab" / "numba"  # where earlier versions kept them
+    if sys.prefix != sys.base_prefix and legacy != folder and legacy.is_dir():
+        shutil.rmtree(legacy, ignore_errors=True)
+        print(f"impstab: removed {legacy}")
     return 0
 
 
