@@ -157,3 +157,35 @@ print(json.dumps([r.thrust, p.load]))
     reference = json.loads(_python(_THRUSTS.format(names=["imp_viscoelastic.toml"]), IMPSTAB_JIT="interpreted"))
     assert abs(thrust - reference["thrusts"]["imp_viscoelastic.toml"]) <= 1e-11 * thrust
     assert abs(load - 1.5) <= 1e-9
+
+
+_ANNOUNCED = """
+import json, numpy as np, impstab._jit as jit
+lines = []
+jit.announce_compiling(lines.append)
+jit.require_compiled()
+from impstab.kinematics.so3 import _cross, _skew
+_skew(np.ones(3))  # the first compile: one line
+_cross(np.ones(3), np.ones(3))  # a second compile: no more
+print(json.dumps(lines))
+"""
+
+
+def test_the_first_compile_is_announced_once_and_a_cache_load_is_not(tmp_path):
+    from impstab import _jit
+
+    cache = str(tmp_path / "kernels")
+    assert json.loads(_python(_ANNOUNCED, NUMBA_CACHE_DIR=cache)) == [_jit.COMPILING]
+    assert json.loads(_python(_ANNOUNCED, NUMBA_CACHE_DIR=cache)) == []  # both loaded from the cache
+
+
+def test_the_command_line_announces_compiling_on_standard_error(monkeypatch, capsys):
+    from impstab import _jit
+    from impstab.cli import main
+
+    writers = []
+    monkeypatch.setattr(_jit, "announce_compiling", writers.append)
+    assert main(["--version"]) == 0
+    assert len(writers) == 1
+    writers[0]("a line")
+    assert capsys.readouterr().err == "a line\n"

@@ -43,7 +43,7 @@ from contextlib import nullcontext
 from time import thread_time
 from typing import Any
 
-__all__ = ["njit", "objmode", "on_compile", "require_compiled", "compiled", "BUDGET_S", "Kernel"]
+__all__ = ["njit", "objmode", "on_compile", "require_compiled", "compiled", "announce_compiling", "BUDGET_S", "Kernel"]
 
 #: seconds of interpreted kernel time after which the process compiles (CPU time of the calling
 #: thread, so that a loaded machine does not make the same analysis compile): numba's import, its code
@@ -59,6 +59,12 @@ _lock = threading.RLock()
 _local = threading.local()
 _spent = 0.0
 _compiled = False
+#: called once with a line when the process next compiles (see :func:`announce_compiling`)
+_announce: Callable[[str], None] | None = None
+_listening = False
+#: the line
+COMPILING = ("impstab: compiling numba kernels for their first use on this machine, once (later runs load them "
+             "from the cache; `python -m impstab.precompile` compiles them all ahead)")
 
 
 def _policy() -> str:
@@ -174,6 +180,38 @@ def on_compile(hook: Callable[[], None]) -> Callable[[], None]:
     return hook
 
 
+def announce_compiling(write: Callable[[str], None] | None) -> None:
+    """Call ``write`` with :data:`COMPILING` when this process next starts compiling a kernel (not
+    when it loads one from the cache), once; ``None`` takes a writer back. The command line passes
+    a writer to standard error, so that its user knows why the first run on a machine takes longer."""
+    global _announce
+    with _lock:
+        _announce = write
+        if _compiled and write is not None:
+            _listen()
+
+
+def _listen() -> None:
+    """Register the listener of numba's compile events behind :func:`announce_compiling` (once)."""
+    global _listening
+    if _listening:
+        return
+    from numba.core import event
+
+    class FirstCompile(event.Listener):
+        def on_start(self, ev: Any) -> None:
+            global _announce
+            write, _announce = _announce, None
+            if write is not None:
+                write(COMPILING)
+
+        def on_end(self, ev: Any) -> None:
+            return None
+
+    event.register("numba:compile", FirstCompile())
+    _listening = True
+
+
 def compiled() -> bool:
     """Whether this process runs the compiled kernels."""
     return _compiled
@@ -203,6 +241,8 @@ def require_compiled(force: bool = False) -> None:
             kernel.dispatcher = numba.njit(**kernel.options)(kernel.py_func)
         _rebind(numba.objmode)
         globals()["objmode"] = numba.objmode
+        if _announce is not None:
+            _listen()
         _compiled = True
 
 

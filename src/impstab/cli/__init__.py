@@ -125,9 +125,11 @@ def cli() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Console entry point; returns the exit code."""
+    from .. import _jit
     from .._blas import prefer_single_thread
 
     prefer_single_thread()  # before numpy loads (see impstab._blas)
+    _jit.announce_compiling(lambda line: print(line, file=sys.stderr, flush=True))
     code = run_guarded(cli, argv)
     if argv is None:
         sys.exit(code)
