@@ -222,6 +222,20 @@ def test_two_clones_share_the_compiled_kernels_and_other_code_keeps_numbas_layou
     assert other_hits == 1 and not (Path(folder_a) / "other").exists()
 
 
+def test_cache_root_is_the_users_cache_folder_else_the_environments(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert _numba_cache.cache_root() == tmp_path / "xdg" / "impstab"
+    monkeypatch.setenv("XDG_CACHE_HOME", "relative/cache")  # not absolute: ignored (XDG base directories)
+    assert _numba_cache.cache_root() == Path.home() / ".cache" / "impstab"
+    (tmp_path / "a-file").write_text("")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "a-file" / "cache"))  # cannot be made
+    expected = Path(sys.prefix) / "var" / "cache" / "impstab"
+    if sys.prefix != sys.base_prefix and os.access(sys.prefix, os.W_OK):
+        assert _numba_cache.cache_root() == expected
+    else:
+        assert _numba_cache.cache_root() == tmp_path / "a-file" / "cache" / "impstab"
+
+
 def test_prune_keeps_the_most_recently_compiled_sources(tmp_path, monkeypatch):
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.delenv(_numba_cache.SET_BY_IMPSTAB, raising=False)
@@ -297,7 +311,8 @@ def test_precompile_stops_at_a_complete_cache_and_keeps_the_users_own(tmp_path, 
     assert precompile.main(["--quiet"]) == 0
     assert "already compiled" in capsys.readouterr().out
     assert precompile.main(["--clean"]) == 0
-    assert "not removed" in capsys.readouterr().out and (own / _numba_cache.versions_tag() / precompile.MARKER).is_file()
+    assert "not removed" in capsys.readouterr().out
+    assert (own / _numba_cache.versions_tag() / precompile.MARKER).is_file()
 
 
 def test_concurrent_cache_saves_of_one_kernel_keep_every_signature(tmp_path, monkeypatch):

@@ -79,7 +79,8 @@ def _user_cache() -> Path:
     if os.name == "nt":  # pragma: no cover - not run on this platform
         base = os.environ.get("LOCALAPPDATA") or str(Path.home() / "AppData" / "Local")
         return Path(base) / "impstab" / "Cache"
-    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "impstab"
+    xdg = os.environ.get("XDG_CACHE_HOME", "")  # a relative one is ignored, as the specification says
+    return Path(xdg if os.path.isabs(xdg) else Path.home() / ".cache") / "impstab"
 
 
 def _writable(folder: Path) -> bool:
