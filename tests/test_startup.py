@@ -251,9 +251,14 @@ def test_prune_keeps_the_most_recently_compiled_sources(tmp_path, monkeypatch):
     os.utime(current.parent / "old0", (1e9 + 1,) * 2)  # a recent folder, but its marker is the oldest
     (current.parent / "partial" / "env").mkdir(parents=True)
     os.utime(current.parent / "partial", (1e9 - 86400 * 10,) * 2)
-    removed = _numba_cache.prune(keep=3)
-    assert sorted(p.name for p in removed) == ["old0", "old1", "old2", "partial"]
+    environment = tmp_path / "venv" / "var" / "cache" / "impstab" / "numba"  # where earlier versions kept kernels
+    (environment / "somekey").mkdir(parents=True)
+    removed = _numba_cache.prune(keep=3, environment=environment)
+    assert sorted(p.name for p in removed) == ["numba", "old0", "old1", "old2", "partial"]
     assert sorted(p.name for p in current.parent.iterdir()) == sorted(["old3", "old4", current.name])
+    assert not environment.exists() and environment.parent.is_dir()
+    # the environment's folder in use (the user's cache folder cannot be written): kept
+    assert current.parent not in _numba_cache.prune(keep=3, environment=current.parent) and current.is_dir()
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "own"))  # the user's own folder: never pruned
     assert _numba_cache.prune(keep=1) == [] and (current.parent / "old4").is_dir()
 

@@ -26,7 +26,8 @@ placed instead by their path inside the package (:func:`locate_by_package`, a ca
 in front of numba's own when the process compiles), so any clone or environment with the same
 sources, at any path, loads the machine code the first one compiled. ``python -m
 impstab.precompile`` keeps the :data:`KEEP` most recently compiled key folders and removes older
-ones (:func:`prune`); ``make clean-cache`` removes them all.
+ones, and the virtual environment's folder where earlier versions kept the kernels (:func:`prune`);
+``make clean-cache`` removes them all.
 
 The hook costs nothing until numba is imported: :func:`install` puts a finder in front of
 ``sys.meta_path`` that computes the folder (a few milliseconds) when the first ``import numba``
@@ -97,8 +98,9 @@ def cache_root() -> Path:
     user = _user_cache()
     if _writable(user):
         return user
-    if sys.prefix != sys.base_prefix and os.access(sys.prefix, os.W_OK):
-        return Path(sys.prefix) / "var" / "cache" / "impstab"
+    environment = _environment_cache()
+    if environment is not None and os.access(sys.prefix, os.W_OK):
+        return environment.parent
     return user
 
 
@@ -322,10 +324,18 @@ def locate_by_package() -> None:
     impl._locator_classes.insert(0, PackageCacheLocator)
 
 
-def prune(keep: int = KEEP) -> list[Path]:
+def _environment_cache() -> Path | None:
+    """The virtual environment's cache folder (the fallback of :func:`cache_root`; every kernel's
+    home before the cache was shared), or ``None`` outside one."""
+    return Path(sys.prefix) / "var" / "cache" / "impstab" / "numba" if sys.prefix != sys.base_prefix else None
+
+
+def prune(keep: int = KEEP, environment: Path | None = None) -> list[Path]:
     """Remove the key folders of impstab's shared cache but the ``keep`` most recently compiled
-    (and the current one); returns the folders removed. A process still loading from a removed
-    folder compiles what it cannot find (numba treats a missing cache file as a miss)."""
+    (and the current one), and the environment's own cache folder (``environment``, default that
+    of the running virtual environment) when the shared one is in use; returns the folders
+    removed. A process still loading from a removed folder compiles what it cannot find (numba
+    treats a missing cache file as a miss)."""
     import shutil
 
     if user_setting():
@@ -339,6 +349,9 @@ def prune(keep: int = KEEP) -> list[Path]:
 
     folders.sort(key=last_compiled, reverse=True)
     removed = folders[max(0, keep - 1):]
+    environment = environment if environment is not None else _environment_cache()
+    if environment is not None and environment.is_dir() and environment != current.parent:
+        removed.append(environment)
     for folder in removed:
         shutil.rmtree(folder, ignore_errors=True)
     return removed

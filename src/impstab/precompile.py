@@ -366,7 +366,7 @@ def main(argv: list[str] | None = None) -> int:
     marker.parent.mkdir(parents=True, exist_ok=True)
     marker.write_text(f"{total} cases\n", encoding="utf-8")
     for folder in _numba_cache.prune():
-        print(f"impstab: removed the kernels of older sources, {folder}")
+        print(f"impstab: removed older compiled kernels, {folder}")
     return 0
 
 
@@ -393,10 +393,10 @@ def _clean() -> int:
     folder = _numba_cache.cache_root() / "numba"
     shutil.rmtree(folder, ignore_errors=True)
     print(f"impstab: removed {folder}")
-    legacy = Path(sys.prefix) / "var" / "cache" / "impstab" / "numba"  # where earlier versions kept them
-    if sys.prefix != sys.base_prefix and legacy != folder and legacy.is_dir():
-        shutil.rmtree(legacy, ignore_errors=True)
-        print(f"impstab: removed {legacy}")
+    environment = _numba_cache._environment_cache()  # where earlier versions kept them
+    if environment is not None and environment != folder and environment.is_dir():
+        shutil.rmtree(environment, ignore_errors=True)
+        print(f"impstab: removed {environment}")
     return 0
 
 
