@@ -43,7 +43,8 @@ from contextlib import nullcontext
 from time import thread_time
 from typing import Any
 
-__all__ = ["njit", "objmode", "on_compile", "require_compiled", "compiled", "announce_compiling", "BUDGET_S", "Kernel"]
+__all__ = ["njit", "objmode", "on_compile", "require_compiled", "compiled", "announce_compiling", "COMPILING",
+           "BUDGET_S", "Kernel"]
 
 #: seconds of interpreted kernel time after which the process compiles (CPU time of the calling
 #: thread, so that a loaded machine does not make the same analysis compile): numba's import, its code

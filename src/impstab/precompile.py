@@ -3,8 +3,8 @@
 ``python -m impstab.precompile`` (run by ``make demo`` and ``make test`` after installing) runs
 each command on small cases through the command line, so that numba compiles each kernel with
 the argument types the commands give it and stores it in the cache of
-:mod:`impstab._numba_cache` (outside the source tree, shared by every clone on the machine; kept until
-the kernels' sources change).
+:mod:`impstab._numba_cache` (outside the source tree, shared by every clone on the machine; kept
+until the kernels' sources change).
 A later ``impstab critical`` or ``impstab simulate`` loads the machine code instead of compiling
 it for minutes.
 
@@ -315,7 +315,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("-q", "--quiet", action="store_true", help="only the first and the summary line")
     parser.add_argument("--force", action="store_true", help="run the cases even if this cache is complete")
     parser.add_argument("--clean", action="store_true",
-                        help="remove impstab's compiled kernels (every cache folder, shared by the clones on this machine) and stop")
+                        help="remove impstab's compiled kernels (every cache folder, shared by the clones on this "
+                             "machine) and stop")
     args = parser.parse_args(argv)
 
     from ._blas import prefer_single_thread
