@@ -53,7 +53,7 @@ demo: compile
 # each test process collects in 7 s instead of 13 s from the second run on, where
 # PYTHONDONTWRITEBYTECODE (set in many containers) would make every run rewrite them again
 test: compile
-	MPLBACKEND=Agg PYTHONDONTWRITEBYTECODE= $(PY) -m pytest -q -n $(JOBS) --dist loadscope
+	MPLBACKEND=Agg PYTHONDONTWRITEBYTECODE= $(PY) -m pytest -q -n $(JOBS) --dist loadscope --no-loadscope-reorder
 
 bench: compile
 	$(PY) benchmarks/startup.py

@@ -13,15 +13,19 @@ import pytest  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 
-#: the modules that take longest (7 to 45 s of one worker each, measured on two cores), first:
-#: ``make test`` keeps each module on one worker (``--dist loadscope``), and a long module handed
-#: out last leaves the other worker idle until it ends
+#: the modules that take longest (2 to 40 s of one worker each, measured on two cores), longest
+#: first: ``make test`` keeps each module on one worker (``--dist loadscope``), and a long module
+#: handed out last leaves the other worker idle until it ends (every module of 2 s or more is
+#: named, so that what is left at the end is a second or less)
 LONGEST_FIRST = (
-    "test_docs_commands.py", "studies/test_store_faults_kill.py", "postcritical/test_onset_labels.py",
-    "studies/test_store_faults.py", "postcritical/test_propulsor.py", "dynamics/test_dyn_beam_mounts.py",
-    "report/test_report_content.py", "test_jit.py", "report/test_report_browser.py",
-    "postcritical/test_propulsor_beam_mounts.py", "studies/test_statistics.py", "studies/test_store_faults_disk.py",
-    "studies/test_dask.py", "studies/test_store_resume.py",
+    "studies/test_store_faults_kill.py", "test_docs_commands.py", "studies/test_store_faults.py", "test_jit.py",
+    "postcritical/test_propulsor.py", "report/test_report_content.py", "postcritical/test_propulsor_beam_mounts.py",
+    "studies/test_dask.py", "report/test_report_browser.py", "studies/test_store_resume.py",
+    "postcritical/test_onset_labels.py", "postcritical/test_propulsor_viscoelastic.py", "test_startup.py",
+    "studies/test_statistics.py", "dynamics/test_dyn_beam_mounts.py", "studies/test_store_faults_disk.py",
+    "plot/test_style_and_files.py", "dynamics/test_dyn_mount_laws.py", "postcritical/test_continuation.py",
+    "linear/test_large_damped.py", "fuzz/test_fuzz_model_files.py", "fuzz/test_fuzz_arguments.py",
+    "dynamics/test_dyn_integrators.py", "dynamics/test_dyn_viscoelastic.py",
 )
 
 
