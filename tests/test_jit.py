@@ -179,6 +179,53 @@ def test_the_first_compile_is_announced_once_and_a_cache_load_is_not(tmp_path):
     assert json.loads(_python(_ANNOUNCED, NUMBA_CACHE_DIR=cache)) == []  # both loaded from the cache
 
 
+_OBJMODE_KERNEL = """
+import numpy as np
+from impstab._jit import njit, objmode
+
+
+def host(x):
+    return float(np.sum(x))
+
+
+@njit(cache=True)
+def kernel(x):
+    with objmode(total="float64"):
+        total = host(x)
+    return 2.0 * total
+"""
+
+_ANNOUNCED_OBJMODE = """
+import json, sys, numpy as np, impstab._jit as jit
+lines = []
+jit.announce_compiling(lines.append)
+jit.require_compiled()
+sys.path.insert(0, sys.argv[1])
+from objmode_kernel import kernel
+assert kernel(np.ones(3)) == 6.0
+print(json.dumps(lines))
+"""
+
+
+def test_an_object_mode_block_is_not_announced_as_compiling(tmp_path):
+    """numba makes the object-mode blocks of a kernel loaded from the cache again in every process
+    (Python calls, not machine code; milliseconds): no line, or every run of the command would
+    claim a first compile."""
+    from impstab import _jit
+
+    (tmp_path / "objmode_kernel.py").write_text(_OBJMODE_KERNEL, encoding="utf-8")
+    cache = str(tmp_path / "kernels")
+    run = [sys.executable, "-c", _ANNOUNCED_OBJMODE, str(tmp_path)]
+    env = dict(os.environ, IMPSTAB_JIT="auto", NUMBA_CACHE_DIR=cache,
+               PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    outputs = []
+    for _ in range(2):
+        done = subprocess.run(run, capture_output=True, text=True, env=env, timeout=600)
+        assert done.returncode == 0, done.stderr
+        outputs.append(json.loads(done.stdout.strip().splitlines()[-1]))
+    assert outputs == [[_jit.COMPILING], []]
+
+
 def test_the_command_line_announces_compiling_on_standard_error(monkeypatch, capsys):
     from impstab import _jit
     from impstab.cli import main

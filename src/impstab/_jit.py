@@ -198,10 +198,15 @@ def _listen() -> None:
     if _listening:
         return
     from numba.core import event
+    from numba.core.dispatcher import LiftedCode
 
     class FirstCompile(event.Listener):
         def on_start(self, ev: Any) -> None:
             global _announce
+            # an object-mode block (a lifted ``with objmode``) is made again in every process, even
+            # of a kernel loaded from the cache: Python calls, milliseconds, no machine code
+            if isinstance(ev.data.get("dispatcher"), LiftedCode):
+                return
             write, _announce = _announce, None
             if write is not None:
                 write(COMPILING)
