@@ -51,7 +51,9 @@ demo: compile
 
 # pytest keeps the test modules it rewrites (for its assertion messages) as bytecode beside them:
 # each test process collects in 7 s instead of 13 s from the second run on, where
-# PYTHONDONTWRITEBYTECODE (set in many containers) would make every run rewrite them again
+# PYTHONDONTWRITEBYTECODE (set in many containers) would make every run rewrite them again;
+# --no-loadscope-reorder keeps tests/conftest.py's longest-first order of the modules (pytest-xdist
+# would order them by their number of tests, and a long module handed out last idles the other worker)
 test: compile
 	MPLBACKEND=Agg PYTHONDONTWRITEBYTECODE= $(PY) -m pytest -q -n $(JOBS) --dist loadscope --no-loadscope-reorder
 
