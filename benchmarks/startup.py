@@ -37,9 +37,9 @@ import json
 import os
 import resource
 import statistics
+import shutil
 import subprocess
 import sys
-import shutil
 import tempfile
 import time
 from pathlib import Path
